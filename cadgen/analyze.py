@@ -1,0 +1,197 @@
+"""`cadgen analyze`: kinematics, design metrics, report.json and plots of one design."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import platform
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["AnalysisResult", "run_analysis", "format_metrics_table", "report_dict"]
+
+
+@dataclass
+class AnalysisResult:
+    """What one analysis produced: the evaluation, the report and where it was written."""
+
+    name: str
+    report: dict
+    output_dir: Path | None
+    files: list = field(default_factory=list)
+
+    def summary_text(self) -> str:
+        return format_metrics_table(self.report) + (
+            f"\nwrote {len(self.files)} files to {self.output_dir}" if self.output_dir else "")
+
+
+def _stage(timings: dict, name: str):
+    class _Timer:
+        def __enter__(self):
+            self.start = time.perf_counter()
+
+        def __exit__(self, *exc):
+            timings[name] = round(time.perf_counter() - self.start, 6)
+
+    return _Timer()
+
+
+def input_hash(params) -> str:
+    """SHA-256 of the validated parameters in canonical JSON (same design, same hash)."""
+    canonical = json.dumps(params.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+def _versions() -> dict:
+    import scipy
+
+    from . import __version__
+
+    return {"cadgen": __version__, "python": platform.python_version(),
+            "numpy": np.__version__, "scipy": scipy.__version__}
+
+
+def report_dict(params, mechanism, evaluation, timings) -> dict:
+    """The JSON report: parameters, derived geometry, metrics against targets, accuracy."""
+    closure = mechanism.closure
+    ratio_1, ratio_2 = mechanism.converted_ratios
+    events = evaluation.events
+    per_spacing = []
+    for hole in evaluation.holes:
+        s = hole.spacing
+        per_spacing.append({
+            "spacing_mm": s, "hole_width_mm": hole.width, "hole_verticality_mm": hole.verticality,
+            "hole_span_mm": hole.span, "x_entry_mm": hole.x_entry, "x_exit_mm": hole.x_exit,
+            "x_lowest_mm": hole.x_lowest,
+            "tip_velocity_absolute_lowest_mm_s": evaluation.speeds["absolute_lowest"][s],
+            "tip_velocity_absolute_catching_mm_s": evaluation.speeds["absolute_catching"][s],
+        })
+    return {
+        "design": params.name,
+        "mechanism": params.mechanism,
+        "input_sha256": input_hash(params),
+        "passed": evaluation.passed,
+        "metrics": [{"key": m.key, "label": m.label, "value": m.value, "unit": m.unit,
+                     "target": m.target, "passed": m.passed, "spacing_mm": m.spacing}
+                    for m in evaluation.metrics],
+        "per_spacing": per_spacing,
+        "events": {
+            "carrier_angle_deg": {"catching": 0.0, "entry": math.degrees(events.entry),
+                                  "lowest": math.degrees(events.lowest),
+                                  "exit": math.degrees(events.exit)},
+            "attitude_deg": evaluation.attitudes_deg,
+            "tip_height_mm": {"catching": events.lowest_height + evaluation.catch_to_plant_height,
+                              "lowest": events.lowest_height, "highest": events.highest_height},
+            "soil_level_mm": events.soil_level,
+            "catch_to_plant_height_mm": evaluation.catch_to_plant_height,
+            "soil_penetrations": events.penetrations,
+            "tip_velocity_relative_lowest_mm_s": evaluation.speeds["relative_lowest"],
+            "tip_velocity_relative_catching_mm_s": evaluation.speeds["relative_catching"],
+            "carrier_speed_rpm": evaluation.carrier_speed_rpm,
+        },
+        "derived": {
+            "centre_distance_a_mm": closure.centre_distance,
+            "carrier_radii_mm": mechanism.carrier_radii,
+            "path_height_of_E_mm": mechanism.path_height_of_E(),
+            "pitch_radius_min_mm": closure.radius_min[1],
+            "pitch_radius_max_mm": closure.radius_max[1],
+            "intermediate_radius_min_mm": closure.centre_distance - closure.radius_max[1],
+            "ratio_min": closure.ratio_min, "ratio_max": closure.ratio_max,
+            "pitch_perimeter_mm": evaluation.perimeter,
+            "module_mm": evaluation.module,
+            "converted_ratios_train1": {"gearbox2_set": ratio_1, "central_gear_set": ratio_2},
+            "arm_distance_at_deg": evaluation.arm_distance_at_deg,
+            "ground_clearance_at_deg": evaluation.extras["ground_clearance_at_deg"],
+            "ground_clearance_nearest": f"{evaluation.ground_clearance_circle.gearbox} at "
+                                        f"{evaluation.ground_clearance_circle.point}",
+            "housing_circles_mm": [{"gearbox": c.gearbox, "axis": c.point, "radius": c.radius}
+                                   for c in evaluation.housing_circles],
+            "clearance_method": "kinematic: centre lines C-E-P1-N and housing envelope circles",
+        },
+        "accuracy": evaluation.accuracy,
+        "stages_s": timings,
+        "versions": _versions(),
+        "parameters": params.model_dump(mode="json"),
+    }
+
+
+def format_metrics_table(report: dict) -> str:
+    """Plain-text table of the metrics against their targets."""
+    rows = [("metric", "spacing", "value", "target", "")]
+    for m in report["metrics"]:
+        spacing = f"{m['spacing_mm']:g} mm" if m["spacing_mm"] is not None else ""
+        value = f"{m['value']:.3f} {m['unit']}".strip()
+        rows.append((m["label"], spacing, value, f"{m['target']} {m['unit']}".strip(),
+                     "pass" if m["passed"] else "FAIL"))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    lines = [f"design {report['design']} ({report['mechanism']} mechanism): "
+             f"{'all targets met' if report['passed'] else 'TARGETS MISSED'}"]
+    for k, row in enumerate(rows):
+        lines.append("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        if k == 0:
+            lines.append("  ".join("-" * w for w in widths))
+    ev = report["events"]
+    att = ev["attitude_deg"]
+    lines.append("")
+    lines.append("attitude Psi (deg): catching {catching:.3f}, entry {entry:.3f}, lowest {lowest:.3f}, "
+                 "exit {exit:.3f}".format(**att))
+    vl = ev["tip_velocity_relative_lowest_mm_s"]
+    lines.append(f"tip velocity at the lowest point, relative: ({vl[0]:.2f}, {vl[1]:.2f}) mm/s "
+                 f"at {ev['carrier_speed_rpm']:g} r/min")
+    for row in report["per_spacing"]:
+        v = row["tip_velocity_absolute_lowest_mm_s"]
+        lines.append(f"  absolute at S = {row['spacing_mm']:g} mm: ({v[0]:.2f}, {v[1]:.2f}) mm/s")
+    lines.append(f"catching-to-planting height: {ev['catch_to_plant_height_mm']:.3f} mm")
+    d = report["derived"]
+    lines.append(f"centre distance a = {d['centre_distance_a_mm']:.6f} mm, "
+                 f"module {d['module_mm']:.4f} mm, ratio {d['ratio_min']:.4f}..{d['ratio_max']:.4f}")
+    return "\n".join(lines)
+
+
+def run_analysis(params, output_root: Path | str | None = Path("outputs"),
+                 steps_per_revolution: int | None = None, plots: bool = True) -> AnalysisResult:
+    """Analyse one validated design; write ``<output_root>/<name>/`` atomically.
+
+    With ``output_root=None`` nothing is written (the report is still returned).
+    """
+    from .design import build_mechanism, evaluate
+
+    timings: dict = {}
+    with _stage(timings, "kinematics"):
+        mechanism = build_mechanism(params)
+        mechanism.closure  # solve the closure inside its own stage
+    with _stage(timings, "metrics"):
+        evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
+    figures = {}
+    if plots and output_root is not None:
+        with _stage(timings, "plots"):
+            from .plots import planting_figures
+
+            figures = planting_figures(mechanism, evaluation)
+    report = report_dict(params, mechanism, evaluation, timings)
+    if output_root is None:
+        return AnalysisResult(params.name, report, None)
+    from .atomic import staged_directory
+
+    final = Path(output_root) / params.name
+    files = []
+    with staged_directory(final) as staging:
+        (staging / "plots").mkdir()
+        for name, data in figures.items():
+            (staging / "plots" / name).write_bytes(data)
+            files.append(f"plots/{name}")
+        (staging / "report.json").write_text(json.dumps(report, indent=2, default=_jsonable) + "\n")
+        files.append("report.json")
+    return AnalysisResult(params.name, report, final, sorted(files))
+
+
+def _jsonable(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")

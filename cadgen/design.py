@@ -1,0 +1,53 @@
+"""From validated parameters to the kinematic model and its evaluation (planting mechanism)."""
+
+from __future__ import annotations
+
+import math
+
+from kinematics.clearance import HousingCircle
+from kinematics.evaluation import Targets, default_housing_circles, evaluate_planting
+from kinematics.pitch_curves import LimaconPitchCurve
+from kinematics.planting import PlantingMechanism
+
+__all__ = ["build_mechanism", "housing_circles", "targets_of", "evaluate"]
+
+
+def build_mechanism(params) -> PlantingMechanism:
+    """The :class:`~kinematics.planting.PlantingMechanism` a validated parameter model describes."""
+    curve = params.pitch_curve
+    train = params.train
+    return PlantingMechanism(
+        pitch_curve=LimaconPitchCurve(
+            a1=curve.a1, b1=curve.b1, c1=curve.c1, d1=curve.d1, e1=curve.e1, e2=curve.e2,
+            f1=curve.f1_rad, f2=curve.f2_rad, g1=curve.g1, g2=curve.g2),
+        i12=train.i12, i13=train.i13, R=train.R, r=train.r,
+        L1=params.planter.L1, L2=params.planter.L2,
+        phi0=math.radians(train.phi0_deg), phic=math.radians(train.phic_deg), n=train.n,
+        closure_rtol=params.resolution.closure_rtol)
+
+
+def housing_circles(params, mechanism: PlantingMechanism, module: float):
+    """Envelope circles: derived from the gear sizes, with any explicit radius in the file winning."""
+    circles = default_housing_circles(mechanism, module, params.housing.wall)
+    explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
+    return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
+            for c in circles]
+
+
+def targets_of(params) -> Targets:
+    return Targets(**params.targets.model_dump())
+
+
+def evaluate(params, mechanism: PlantingMechanism | None = None, steps: int | None = None):
+    """Evaluate every design metric of a validated planting design."""
+    mechanism = mechanism or build_mechanism(params)
+    teeth = params.pitch_curve.teeth
+    from kinematics.pitch_curves import polar_perimeter
+
+    module = polar_perimeter(mechanism.pitch_curve) / (math.pi * teeth)
+    return evaluate_planting(
+        mechanism, teeth=teeth, depth=params.field.depth, spacings=params.field.plant_spacings,
+        carrier_speed_rpm=params.field.carrier_speed_rpm,
+        housing_circles=housing_circles(params, mechanism, module),
+        targets=targets_of(params),
+        steps=steps or params.resolution.steps_per_revolution)

@@ -1,0 +1,48 @@
+"""Design feasibility checks that need the kinematic model.
+
+Run after the parameter file is structurally valid; each returns problems with
+the field path a designer should change, never raises for a bad design.
+"""
+
+from __future__ import annotations
+
+import math
+
+from kinematics.errors import ConvergenceError, DesignError, Problem
+from kinematics.metrics import vertical_extremes
+from kinematics.pitch_curves import pair_problems, polar_perimeter
+
+__all__ = ["design_problems"]
+
+
+def design_problems(params) -> list:
+    """Every reason a structurally valid design cannot be built, as :class:`Problem` records.
+
+    Checks: the pitch curve closes (and is not pointed); both non-circular
+    gears' smallest radii clear the cutting limit for the module; the planting
+    depth leaves the tip a way out of the soil.
+    """
+    if getattr(params, "mechanism", "planting") != "planting":
+        return []
+    from .design import build_mechanism
+
+    try:
+        mechanism = build_mechanism(params)
+        closure = mechanism.closure
+        module = polar_perimeter(mechanism.pitch_curve) / (math.pi * params.pitch_curve.teeth)
+    except DesignError as error:
+        return list(error.problems)
+    except ConvergenceError as error:
+        return [Problem("pitch_curve", "closure_not_converged", str(error))]
+    problems = pair_problems(closure, module)
+    if problems:
+        return problems
+    lowest, highest = vertical_extremes(mechanism.tip_path(),
+                                        steps=params.resolution.steps_per_revolution)
+    height = -highest.value - lowest.value
+    if params.field.depth >= height:
+        problems.append(Problem(
+            "field.depth", "no_soil_crossing",
+            f"planting depth {params.field.depth:g} mm is not less than the tip path's height "
+            f"{height:.3f} mm: the tip never leaves the soil"))
+    return problems

@@ -1,0 +1,148 @@
+"""Plots of the planting mechanism (matplotlib, Agg backend; imported only when plots are asked for)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+__all__ = ["planting_figures"]
+
+
+def _figure(width=7.5, height=5.0):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(figsize=(width, height), dpi=110)
+    return figure, axes
+
+
+def _png(figure) -> bytes:
+    import matplotlib.pyplot as plt
+
+    buffer = io.BytesIO()
+    figure.tight_layout()
+    # no software/date metadata, so the same design gives the same bytes
+    figure.savefig(buffer, format="png", metadata={"Software": None})
+    plt.close(figure)
+    return buffer.getvalue()
+
+
+def _events_deg(evaluation):
+    ev = evaluation.events
+    return {"entry": ev.entry, "lowest": ev.lowest, "exit": ev.exit}
+
+
+def relative_path(mechanism, evaluation, phi):
+    figure, ax = _figure(6.5, 7.5)
+    for arm, colour in ((0, "tab:blue"), (1, "tab:orange")):
+        tip = mechanism.motion(phi, "N", arm).position
+        ax.plot(tip[:, 0], tip[:, 1], color=colour, lw=1.2, label=f"tip N, arm {arm + 1}")
+        pose = mechanism.positions(np.array([0.0]), arm=arm, points=("C", "E", "P1", "N"))
+        line = np.vstack([pose[k][0] for k in ("C", "E", "P1", "N")])
+        ax.plot([0.0, line[0, 0]], [0.0, line[0, 1]], color="0.5", lw=2)
+        ax.plot(line[:, 0], line[:, 1], "-o", color=colour, lw=2.2, ms=4, alpha=0.8)
+    for circle in evaluation.housing_circles:
+        if circle.gearbox != "gearbox2":
+            continue
+        centre = mechanism.motion(np.array([0.0]), circle.point).position[0]
+        ax.add_patch(__import__("matplotlib.patches", fromlist=["Circle"]).Circle(
+            centre, circle.radius, fill=False, ls=":", color="0.4"))
+    ax.axhline(evaluation.events.soil_level, color="saddlebrown", lw=1.5, label="soil surface")
+    ax.plot([0], [0], "k+", ms=12)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm, forward travel)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title("Relative tip path (bench idle run), both arms at the catching pose")
+    ax.legend(loc="upper right", fontsize=8)
+    ax.grid(alpha=0.3)
+    return _png(figure)
+
+
+def absolute_paths(mechanism, evaluation, phi):
+    figure, ax = _figure(9.0, 5.0)
+    tip = mechanism.motion(phi, "N").position
+    for hole in evaluation.holes:
+        x = tip[:, 0] + hole.spacing / np.pi * phi
+        ax.plot(x, tip[:, 1], lw=1.2, label=f"S = {hole.spacing:g} mm (hole width {hole.width:.1f} mm)")
+        ev = evaluation.events
+        marks = np.array([ev.entry, ev.exit])
+        pts = mechanism.motion(marks, "N").position
+        ax.plot(pts[:, 0] + hole.spacing / np.pi * marks, pts[:, 1], "k|", ms=10)
+    ax.axhline(evaluation.events.soil_level, color="saddlebrown", lw=1.5, label="soil surface")
+    ax.set_aspect("equal")
+    ax.set_xlabel("X (mm, forward travel)")
+    ax.set_ylabel("Y (mm)")
+    ax.set_title("Absolute tip paths over one carrier revolution (| = soil entry, exit)")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    ax.grid(alpha=0.3)
+    return _png(figure)
+
+
+def attitude(mechanism, evaluation, phi):
+    figure, ax = _figure()
+    ax.plot(np.degrees(phi), np.degrees(mechanism.attitude(phi)), lw=1.4)
+    for name, angle in _events_deg(evaluation).items():
+        value = np.degrees(mechanism.attitude(np.array([angle]))[0])
+        ax.plot(np.degrees(angle), value, "o")
+        ax.annotate(f"{name}\n{value:.2f} deg", (np.degrees(angle), value),
+                    textcoords="offset points", xytext=(6, 6), fontsize=8)
+    ax.set_xlabel("carrier angle phi (deg)")
+    ax.set_ylabel("planter attitude Psi (deg, 0 = upright)")
+    ax.set_title("Planter attitude")
+    ax.grid(alpha=0.3)
+    return _png(figure)
+
+
+def velocity(mechanism, evaluation, phi):
+    figure, ax = _figure()
+    omega = 2 * np.pi * evaluation.carrier_speed_rpm / 60.0
+    v = mechanism.motion(phi, "N").velocity * omega
+    ax.plot(np.degrees(phi), np.hypot(v[:, 0], v[:, 1]), lw=1.4, label="relative speed |v|")
+    for hole in evaluation.holes:
+        drift = hole.spacing / np.pi * omega
+        ax.plot(np.degrees(phi), np.hypot(v[:, 0] + drift, v[:, 1]), lw=1.0,
+                label=f"absolute speed, S = {hole.spacing:g} mm")
+    for name, angle in _events_deg(evaluation).items():
+        ax.axvline(np.degrees(angle), color="0.6", ls=":")
+        ax.text(np.degrees(angle), ax.get_ylim()[1] * 0.95, name, fontsize=8, rotation=90, va="top")
+    ax.set_xlabel("carrier angle phi (deg)")
+    ax.set_ylabel(f"tip speed (mm/s at {evaluation.carrier_speed_rpm:g} r/min)")
+    ax.set_title("Tip speed")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return _png(figure)
+
+
+def pitch_curves(mechanism, evaluation, samples=1440):
+    figure, ax = _figure(8.0, 5.0)
+    t = np.linspace(0.0, 2 * np.pi, samples + 1)
+    a = mechanism.centre_distance
+    r1 = mechanism.pitch_curve.radius(t)
+    # central gear: polar angle t in its own frame, contact direction towards D at start
+    ax.plot(r1 * np.cos(t), r1 * np.sin(t), lw=1.5, label="central gear r1(t)")
+    # intermediate gear (centre at distance a): radius a - r1(t) at polar angle pi - F(t)
+    angle = np.pi - mechanism.intermediate_rotation(t)
+    rho = a - r1
+    ax.plot(a + rho * np.cos(angle), rho * np.sin(angle), lw=1.5, label="intermediate gear a - r1(t)")
+    ax.plot([0, a], [0, 0], "k+", ms=10)
+    ax.plot([r1[0]], [0], "ro", ms=4, label="contact at the catching position")
+    ax.set_aspect("equal")
+    ax.set_title(f"Non-circular pair: a = {a:.4f} mm, module {evaluation.module:.3f} mm")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return _png(figure)
+
+
+def planting_figures(mechanism, evaluation, samples: int = 1441) -> dict:
+    """PNG bytes of every plot of a planting design, keyed by file name."""
+    phi = np.linspace(0.0, 2 * np.pi, samples)
+    return {
+        "relative_path.png": relative_path(mechanism, evaluation, phi),
+        "absolute_paths.png": absolute_paths(mechanism, evaluation, phi),
+        "attitude.png": attitude(mechanism, evaluation, phi),
+        "tip_velocity.png": velocity(mechanism, evaluation, phi),
+        "pitch_curves.png": pitch_curves(mechanism, evaluation),
+    }

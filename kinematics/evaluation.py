@@ -1,0 +1,200 @@
+"""The planting mechanism's design metrics against their targets (spec table), per plant spacing.
+
+Seven metrics: trajectory height, hole width, hole verticality, entry/exit
+attitude difference, arm distance, gearbox ground clearance, non-circular gear
+module; plus the attitudes at catching, entry, lowest point and exit, the tip
+speeds at the lowest and catching points, the catching-to-planting height, the
+hole span and the number of soil penetrations per plant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import tolerances as tol
+from .clearance import HousingCircle, arm_distance, ground_clearance
+from .metrics import HoleMetrics, PlantEvents, hole_metrics, plant_events
+from .pitch_curves import polar_perimeter
+from .planting import PlantingMechanism
+
+__all__ = ["Targets", "MetricResult", "PlantingEvaluation", "evaluate_planting",
+           "default_housing_circles"]
+
+
+@dataclass(frozen=True)
+class Targets:
+    """The spec's targets (mm, deg); each a keyword so a file can override it."""
+
+    trajectory_height_min: float = 500.0
+    hole_width_max: float = 30.0
+    hole_verticality_max: float = 10.0
+    angle_difference_max_deg: float = 20.0
+    arm_distance_min: float = 10.0
+    ground_clearance_min: float = 20.0
+    module_min: float = 2.5
+
+
+@dataclass(frozen=True)
+class MetricResult:
+    """One metric's value against its target."""
+
+    key: str
+    label: str
+    value: float
+    unit: str
+    target: str
+    passed: bool
+    spacing: float | None = None
+
+
+@dataclass(frozen=True)
+class PlantingEvaluation:
+    """Everything :func:`evaluate_planting` finds. Angles in degrees, lengths mm, speeds mm/s."""
+
+    metrics: list
+    events: PlantEvents
+    holes: list
+    attitudes_deg: dict
+    speeds: dict
+    catch_to_plant_height: float
+    module: float
+    perimeter: float
+    arm_distance_at_deg: float
+    ground_clearance_circle: HousingCircle
+    housing_circles: list
+    accuracy: dict
+    carrier_speed_rpm: float = 30.0
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return all(m.passed for m in self.metrics)
+
+
+def default_housing_circles(mechanism: PlantingMechanism, module: float, wall: float):
+    """Envelope circles of both gearboxes from the gear sizes plus ``wall`` (mm).
+
+    Gearbox 2 holds the non-circular pair and the 1:1 pair: at C the central
+    gear's largest tip radius, at D the larger of the intermediate gear's largest
+    radius ``a - min r1`` and ``r``, at E the planet gear, each plus one module
+    of addendum. Gearbox 1 (carrier 1) uses the first train's gear set with
+    converted ratio -1 (sun R, idlers R i12 and R i13, planet R); the other set
+    is not modelled, so pass explicit radii when it is larger.
+    """
+    closure = mechanism.closure
+    a = closure.centre_distance
+    r_min, r_max = closure.radius_min[1], closure.radius_max[1]
+    R = mechanism.R
+    box2 = {"C": r_max + module + wall, "D": max(a - r_min, mechanism.r) + module + wall,
+            "E": mechanism.r + module + wall}
+    box1 = {"O": R + wall, "A": R * mechanism.i12 + wall, "B": R * mechanism.i13 + wall,
+            "C": R + wall}
+    return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
+            + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])
+
+
+def _deg(x):
+    return float(np.degrees(x))
+
+
+def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
+                      spacings, carrier_speed_rpm: float = 30.0, housing_circles=None,
+                      housing_wall: float = 6.0, targets: Targets = Targets(),
+                      steps: int = tol.STEPS_PER_REVOLUTION) -> PlantingEvaluation:
+    """Evaluate every design metric of the planting mechanism.
+
+    Parameters
+    ----------
+    mechanism : PlantingMechanism
+    teeth : int
+        Tooth count ``z`` of the non-circular gears.
+    depth : float
+        Planting depth (mm): the soil line is ``min(y_N) + depth``.
+    spacings : sequence of float
+        Plant spacings (mm).
+    carrier_speed_rpm : float
+        Carrier-1 speed for speeds in mm/s.
+    housing_circles : list of HousingCircle, optional
+        Defaults to :func:`default_housing_circles` with ``housing_wall``.
+    steps : int
+        Screening samples per revolution before refinement.
+    """
+    omega = 2.0 * np.pi * carrier_speed_rpm / 60.0
+    closure = mechanism.closure
+    perimeter = polar_perimeter(mechanism.pitch_curve)
+    module = perimeter / (np.pi * teeth)
+    tip = mechanism.tip_path()
+    events = plant_events(tip, depth, steps=steps)
+    holes = [hole_metrics(tip, events, float(s), steps=steps) for s in spacings]
+    arms = arm_distance(mechanism, steps=steps)
+    circles = housing_circles if housing_circles is not None else \
+        default_housing_circles(mechanism, module, housing_wall)
+    clearance, nearest = ground_clearance(mechanism, circles, events.soil_level, steps=steps)
+
+    angles = np.array([0.0, events.entry, events.lowest, events.exit])
+    psi = mechanism.attitude(angles)
+    attitudes = {k: _deg(v) for k, v in zip(("catching", "entry", "lowest", "exit"), psi)}
+    tip_motion = mechanism.motion(np.array([events.lowest, 0.0]), "N")
+    relative = tip_motion.velocity * omega
+    speeds = {
+        "relative_lowest": relative[0].tolist(),
+        "relative_catching": relative[1].tolist(),
+        "absolute_lowest": {}, "absolute_catching": {},
+    }
+    for s in spacings:
+        drift = np.array([s / np.pi * omega, 0.0])
+        speeds["absolute_lowest"][float(s)] = (relative[0] + drift).tolist()
+        speeds["absolute_catching"][float(s)] = (relative[1] + drift).tolist()
+    catching_height = float(tip.height(np.array([0.0]))[0])
+    angle_difference = abs(attitudes["exit"] - attitudes["entry"])
+
+    t = targets
+    metrics = [MetricResult("trajectory_height", "trajectory height", events.trajectory_height,
+                            "mm", f"> {t.trajectory_height_min:g}",
+                            events.trajectory_height > t.trajectory_height_min)]
+    for hole in holes:
+        metrics.append(MetricResult("hole_width", "hole width", hole.width, "mm",
+                                    f"0-{t.hole_width_max:g}",
+                                    0.0 <= hole.width <= t.hole_width_max, hole.spacing))
+        metrics.append(MetricResult("hole_verticality", "hole verticality", hole.verticality, "mm",
+                                    f"< {t.hole_verticality_max:g}",
+                                    hole.verticality < t.hole_verticality_max, hole.spacing))
+    metrics += [
+        MetricResult("angle_difference", "entry/exit angle difference", angle_difference, "deg",
+                     f"0-{t.angle_difference_max_deg:g}",
+                     angle_difference <= t.angle_difference_max_deg),
+        MetricResult("arm_distance", "arm distance (centre lines)", arms.value, "mm",
+                     f"> {t.arm_distance_min:g}", arms.value > t.arm_distance_min),
+        MetricResult("ground_clearance", "gearbox ground clearance (envelope circles)",
+                     clearance.value, "mm", f"> {t.ground_clearance_min:g}",
+                     clearance.value > t.ground_clearance_min),
+        MetricResult("module", "non-circular gear module", module, "mm",
+                     f"> {t.module_min:g}", module > t.module_min),
+        MetricResult("soil_penetrations", "soil penetrations per plant", float(events.penetrations),
+                     "", "= 1", events.penetrations == 1),
+    ]
+    accuracy = {
+        "closure_centre_distance_error_mm": closure.error_estimate,
+        "closure_residual": closure.residual,
+        "closure_nodes": closure.nodes,
+        "ratio_fourier_modes": int(len(closure.law.coefficients)),
+        "root_xtol_rad": tol.ROOT_XTOL,
+        "refine_xatol_rad": tol.REFINE_XATOL,
+        "steps_per_revolution": steps,
+        "minimum_searches": {
+            name: {"value": r.value, "certified_bound": r.bound, "certified": r.certified,
+                   "refined_intervals": r.refined_intervals, "evaluations": r.evaluations}
+            for name, r in (("lowest_point", events.lowest_search),
+                            ("highest_point", events.highest_search),
+                            ("arm_distance", arms), ("ground_clearance", clearance))},
+    }
+    return PlantingEvaluation(
+        metrics=metrics, events=events, holes=holes, attitudes_deg=attitudes, speeds=speeds,
+        catch_to_plant_height=catching_height - events.lowest_height, module=module,
+        perimeter=perimeter, arm_distance_at_deg=_deg(arms.argument),
+        ground_clearance_circle=nearest, housing_circles=circles, accuracy=accuracy,
+        carrier_speed_rpm=carrier_speed_rpm,
+        extras={"hole_span": {h.spacing: h.span for h in holes},
+                "ground_clearance_at_deg": _deg(clearance.argument)})

@@ -1,0 +1,29 @@
+"""Shared fixtures: the paper's planting design as a kinematic model."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from kinematics.pitch_curves import LimaconPitchCurve
+from kinematics.planting import PlantingMechanism
+
+REPO = Path(__file__).resolve().parents[1]
+PAPER_LIMACON = dict(a1=1.2, b1=27.5, c1=-5.5, d1=30.5, e1=2.66, e2=1.0,
+                     f1=8.55, f2=4.24, g1=-6.95, g2=-4.0)
+
+
+@pytest.fixture(scope="session")
+def paper_curve():
+    return LimaconPitchCurve(**PAPER_LIMACON)
+
+
+@pytest.fixture(scope="session")
+def paper_mechanism(paper_curve):
+    return PlantingMechanism(paper_curve, i12=1.2, i13=1.1, R=36.0, r=27.0, L1=130.0, L2=190.0,
+                             phi0=np.pi / 2, phic=np.pi / 2, n=3.0)
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(20261121)

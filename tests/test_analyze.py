@@ -1,0 +1,56 @@
+"""`run_analysis`: the files it writes, and nothing partial when it fails."""
+
+import json
+
+import pytest
+
+from cadgen.analyze import run_analysis
+from cadgen.params import load_params
+from tests.helpers import REFERENCE
+
+
+@pytest.fixture(scope="module")
+def params():
+    return load_params(REFERENCE)
+
+
+def test_writes_report_and_plots(params, tmp_path):
+    result = run_analysis(params, output_root=tmp_path)
+    folder = tmp_path / "xin2024-planter"
+    assert sorted(p.name for p in (folder / "plots").iterdir()) == [
+        "absolute_paths.png", "attitude.png", "pitch_curves.png", "relative_path.png",
+        "tip_velocity.png"]
+    report = json.loads((folder / "report.json").read_text())
+    assert report["derived"]["centre_distance_a_mm"] == pytest.approx(59.944, abs=1e-3)
+    assert report["passed"] is True
+    assert {m["key"] for m in report["metrics"]} >= {
+        "trajectory_height", "hole_width", "hole_verticality", "angle_difference",
+        "arm_distance", "ground_clearance", "module"}
+    assert len([m for m in report["metrics"] if m["key"] == "hole_width"]) == 3
+    assert report["input_sha256"] == result.report["input_sha256"]
+    for png in (folder / "plots").iterdir():
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "all targets met" in result.summary_text()
+
+
+def test_failure_leaves_previous_outputs_untouched(params, tmp_path, monkeypatch):
+    run_analysis(params, output_root=tmp_path, plots=False)
+    before = (tmp_path / "xin2024-planter" / "report.json").read_bytes()
+
+    import cadgen.plots
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("plotting failed")
+
+    monkeypatch.setattr(cadgen.plots, "planting_figures", broken)
+    with pytest.raises(RuntimeError):
+        run_analysis(params, output_root=tmp_path)
+    assert (tmp_path / "xin2024-planter" / "report.json").read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["xin2024-planter"]
+
+
+def test_same_input_same_hash(params):
+    first = run_analysis(params, output_root=None)
+    second = run_analysis(params, output_root=None)
+    assert first.report["input_sha256"] == second.report["input_sha256"]
+    assert first.report["metrics"] == second.report["metrics"]
