@@ -110,7 +110,7 @@ def report_dict(params, mechanism, evaluation, timings) -> dict:
                                         f"{evaluation.ground_clearance_circle.point}",
             "housing_circles_mm": [{"gearbox": c.gearbox, "axis": c.point, "radius": c.radius}
                                    for c in evaluation.housing_circles],
-            "clearance_method": "kinematic: centre lines C-E-P1-N and housing envelope circles",
+            "clearance_method": evaluation.extras["clearance_method"],
         },
         "accuracy": evaluation.accuracy,
         "stages_s": timings,

@@ -23,6 +23,7 @@ __all__ = [
     "arm_distance",
     "HousingCircle",
     "ground_clearance",
+    "KinematicClearance",
 ]
 
 
@@ -154,3 +155,26 @@ def ground_clearance(mechanism: PlantingMechanism, circles, soil_level: float, *
     phi = np.array([result.argument])
     gaps = [float(_lowest_of_circles(mechanism, [c], phi)[0]) for c in circles]
     return result, circles[int(np.argmin(gaps))]
+
+
+@dataclass(frozen=True)
+class KinematicClearance:
+    """The kinematic clearance model: centre lines and housing envelope circles.
+
+    :func:`kinematics.evaluation.evaluate_planting` asks a clearance model for
+    ``arm_distance(mechanism, steps)`` and ``ground_clearance(mechanism,
+    soil_level, steps)``, each returning a :class:`CertifiedMinimum` (the ground
+    one also the nearest part); a solid-based (FCL) model with the same two
+    methods takes over when a scene has solids.
+    """
+
+    circles: tuple
+    arm_label: str = "arm distance (centre lines)"
+    ground_label: str = "gearbox ground clearance (envelope circles)"
+    method: str = "kinematic: centre lines C-E-P1-N and housing envelope circles"
+
+    def arm_distance(self, mechanism, steps):
+        return arm_distance(mechanism, steps=steps)
+
+    def ground_clearance(self, mechanism, soil_level, steps):
+        return ground_clearance(mechanism, self.circles, soil_level, steps=steps)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import tolerances as tol
-from .clearance import HousingCircle, arm_distance, ground_clearance
+from .clearance import HousingCircle, KinematicClearance
 from .metrics import HoleMetrics, PlantEvents, hole_metrics, plant_events
 from .pitch_curves import polar_perimeter
 from .planting import PlantingMechanism
@@ -102,7 +102,8 @@ def _deg(x):
 def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
                       spacings, carrier_speed_rpm: float = 30.0, housing_circles=None,
                       housing_wall: float = 6.0, targets: Targets = Targets(),
-                      steps: int = tol.STEPS_PER_REVOLUTION) -> PlantingEvaluation:
+                      steps: int = tol.STEPS_PER_REVOLUTION,
+                      clearance_model=None) -> PlantingEvaluation:
     """Evaluate every design metric of the planting mechanism.
 
     Parameters
@@ -120,6 +121,10 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         Defaults to :func:`default_housing_circles` with ``housing_wall``.
     steps : int
         Screening samples per revolution before refinement.
+    clearance_model : object, optional
+        Supplies ``arm_distance`` and ``ground_clearance`` (see
+        :class:`~kinematics.clearance.KinematicClearance`, the default, built
+        on ``housing_circles``).
     """
     omega = 2.0 * np.pi * carrier_speed_rpm / 60.0
     closure = mechanism.closure
@@ -128,10 +133,11 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
     tip = mechanism.tip_path()
     events = plant_events(tip, depth, steps=steps)
     holes = [hole_metrics(tip, events, float(s), steps=steps) for s in spacings]
-    arms = arm_distance(mechanism, steps=steps)
     circles = housing_circles if housing_circles is not None else \
         default_housing_circles(mechanism, module, housing_wall)
-    clearance, nearest = ground_clearance(mechanism, circles, events.soil_level, steps=steps)
+    model = clearance_model or KinematicClearance(tuple(circles))
+    arms = model.arm_distance(mechanism, steps)
+    clearance, nearest = model.ground_clearance(mechanism, events.soil_level, steps)
 
     angles = np.array([0.0, events.entry, events.lowest, events.exit])
     psi = mechanism.attitude(angles)
@@ -165,10 +171,10 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         MetricResult("angle_difference", "entry/exit angle difference", angle_difference, "deg",
                      f"0-{t.angle_difference_max_deg:g}",
                      angle_difference <= t.angle_difference_max_deg),
-        MetricResult("arm_distance", "arm distance (centre lines)", arms.value, "mm",
+        MetricResult("arm_distance", model.arm_label, arms.value, "mm",
                      f"> {t.arm_distance_min:g}", arms.value > t.arm_distance_min),
-        MetricResult("ground_clearance", "gearbox ground clearance (envelope circles)",
-                     clearance.value, "mm", f"> {t.ground_clearance_min:g}",
+        MetricResult("ground_clearance", model.ground_label, clearance.value, "mm",
+                     f"> {t.ground_clearance_min:g}",
                      clearance.value > t.ground_clearance_min),
         MetricResult("module", "non-circular gear module", module, "mm",
                      f"> {t.module_min:g}", module > t.module_min),
@@ -197,4 +203,5 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         ground_clearance_circle=nearest, housing_circles=circles, accuracy=accuracy,
         carrier_speed_rpm=carrier_speed_rpm,
         extras={"hole_span": {h.spacing: h.span for h in holes},
-                "ground_clearance_at_deg": _deg(clearance.argument)})
+                "ground_clearance_at_deg": _deg(clearance.argument),
+                "clearance_method": model.method})

@@ -158,6 +158,20 @@ class PlantingMechanism:
         offset = np.array([-self.L1, 0.0 if point == "P1" else -self.L2])
         return _rotating_offset(hub, psi, dpsi, ddpsi, offset)
 
+    def absolute_motion(self, phi, spacing: float, point: str = "N", arm: int = 0) -> PointMotion:
+        """Motion over the ground at plant spacing ``spacing`` (mm).
+
+        The machine advances ``2 S`` per carrier revolution, so ``X = x + (S / pi) phi``:
+        the velocity gains ``S / pi`` along x, the acceleration is unchanged
+        (constant forward speed). Per radian; times ``omega`` (``omega**2``) for seconds.
+        """
+        relative = self.motion(phi, point, arm)
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        drift = spacing / np.pi
+        position = relative.position + np.stack([drift * phi, np.zeros_like(phi)], axis=-1)
+        velocity = relative.velocity + np.array([drift, 0.0])
+        return PointMotion(position, velocity, relative.acceleration)
+
     def positions(self, phi, arm: int = 0, points=ARM_POINTS) -> dict:
         """Positions of several named points: ``{name: (n, 2) array}`` (mm).
 

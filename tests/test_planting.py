@@ -103,3 +103,18 @@ def test_tip_path_extremes_against_dense_scan(paper_mechanism):
     assert low.value == pytest.approx(y.min(), abs=1e-9)
     assert -high.value == pytest.approx(y.max(), abs=1e-9)
     assert low.value <= y.min() and -high.value >= y.max()  # refined beats the dense scan
+
+
+def test_absolute_motion_adds_the_forward_drift(paper_mechanism, rng):
+    phi = rng.uniform(0, 2 * np.pi, 20)
+    spacing = 185.0
+    absolute = paper_mechanism.absolute_motion(phi, spacing)
+    relative = paper_mechanism.motion(phi, "N")
+    np.testing.assert_allclose(absolute.position[:, 0], relative.position[:, 0] + spacing / np.pi * phi)
+    # derivatives of X(phi) by 8th-order finite differences
+    h = 2e-3
+    samples = np.array([paper_mechanism.absolute_motion(phi + k * h, spacing).position
+                        for k in range(-4, 5)])
+    np.testing.assert_allclose(np.tensordot(FIRST, samples, 1) / h, absolute.velocity, atol=1e-6)
+    np.testing.assert_allclose(np.tensordot(SECOND, samples, 1) / h**2, absolute.acceleration,
+                               atol=5e-3)
