@@ -1,11 +1,22 @@
 """Parameter files: TOML format, schema and all-problems-at-once validation.
 
-A parameter file names its mechanism kind (``mechanism = "planting"``) and holds
-one table per part of the design. The schema is a set of frozen pydantic models,
-strict about types (a quoted ``"36"`` is not a number, ``true`` is not a number,
-an integer is accepted where a float is asked), finite floats only, and no unknown
-keys. :func:`load_params` and :func:`validate_text` never stop at the first problem:
-they raise one :class:`ParameterError` that lists every problem found, each a
+A parameter file names its mechanism kind and holds one table per part of the design:
+
+* ``mechanism = "planting"`` (kind 1, :class:`PlantingParameters`): the differential
+  planetary planting mechanism, tables ``[pitch_curve]``, ``[train]``, ``[planter]``,
+  ``[field]`` and the optional ``[housing]``, ``[targets]``, ``[resolution]``;
+* ``mechanism = "pricking"`` (kind 2, :class:`PrickingParameters`): the inclined
+  hole-pricking mechanism, inverse-designed from its needle-tip loop, tables
+  ``[trajectory]``, ``[linkage]``, ``[field]`` and the optional ``[gears]``,
+  ``[resolution]``. Only the structure of the type-value points is checked here
+  (at least 5 pairs of finite numbers); their geometry (repeated points,
+  self-intersection, the sun centre inside the loop) is the kinematic model's to judge.
+
+The schema is a set of frozen pydantic models, strict about types (a quoted ``"36"``
+is not a number, ``true`` is not a number, an integer is accepted where a float is
+asked), finite floats only, and no unknown keys. :func:`load_params` and
+:func:`validate_text` never stop at the first problem: they raise one
+:class:`ParameterError` that lists every problem found, each a
 :class:`~kinematics.errors.Problem` with a dotted field path (``train.R``,
 ``field.plant_spacings.1``), a short code and a sentence naming the bad value.
 
@@ -28,8 +39,16 @@ invalid_name        the design name cannot name an output folder
 unknown_mechanism   ``mechanism`` names no known mechanism kind
 unknown_kind        a ``kind`` (e.g. ``pitch_curve.kind``) names no known kind
 inconsistent        a value contradicts a rule that needs no kinematics (``2*e2`` whole)
-duplicate           a plant spacing given twice
+duplicate           a plant spacing or an inclination given twice (reported at the repeat)
+not_allowed         a value outside a fixed set of choices: ``trajectory.degree`` not 3 or 5,
+                    ``gears.split_exponent`` a string other than ``"equal-perimeter"``
 ==================  =====================================================================
+
+Where array problems are reported: an array item at its index
+(``field.inclinations_deg.1``); a type-value point that is not a pair of two finite
+numbers once, at the point's index (``trajectory.points.3``: ``wrong_type`` for a
+wrong shape or a non-number item, ``not_finite`` for nan or inf); too few points at
+the array itself (``trajectory.points``, ``out_of_range``).
 
 Once the file is structurally valid, :func:`cadgen.feasibility.design_problems`
 adds the problems that need the kinematic model (their codes are its own).
@@ -55,6 +74,7 @@ from pydantic import (
     Field,
     TypeAdapter,
     ValidationError,
+    ValidationInfo,
     field_validator,
 )
 from pydantic_core import PydanticCustomError
@@ -74,12 +94,25 @@ __all__ = [
     "DesignTargets",
     "ResolutionParameters",
     "PlantingParameters",
+    "TrajectoryParameters",
+    "LinkageParameters",
+    "GearParameters",
+    "PrickingFieldParameters",
+    "PrickingResolutionParameters",
+    "PrickingParameters",
+    "SplitExponent",
     "DesignParameters",
     "MECHANISM_KINDS",
     "NAME_PATTERN",
     "MIN_TEETH",
     "STEPS_PER_REVOLUTION_RANGE",
     "CLOSURE_RTOL_RANGE",
+    "EQUAL_PERIMETER",
+    "TRAJECTORY_DEGREES",
+    "MIN_TYPE_VALUE_POINTS",
+    "SPLIT_EXPONENT_RANGE",
+    "INCLINATION_MAX_DEG",
+    "INVERSE_GRID_RANGE",
     "load_params",
     "validate_text",
     "validate_data",
@@ -93,6 +126,16 @@ STEPS_PER_REVOLUTION_RANGE = (36, 1_000_000)
 CLOSURE_RTOL_RANGE = (1e-15, 1e-6)
 # 2*e2 must be a whole number; this absorbs the rounding of a decimal such as 1.5 in TOML.
 E2_WHOLE_ABS_TOL = 1e-9
+
+EQUAL_PERIMETER = "equal-perimeter"
+"""``gears.split_exponent`` value asking for the two stages' pitch perimeters to be equal."""
+TRAJECTORY_DEGREES = (3, 5)
+"""Allowed degrees of the closed interpolating curve through the type-value points."""
+MIN_TYPE_VALUE_POINTS = 5
+SPLIT_EXPONENT_RANGE = (0.0, 4.0)
+INCLINATION_MAX_DEG = 80.0
+"""Inclinations theta of the mechanism plane must be in [0, this) degrees."""
+INVERSE_GRID_RANGE = (36, 100_000)
 
 
 class ParameterError(DesignError):
@@ -195,19 +238,24 @@ class FieldParameters(_Table):
     @field_validator("plant_spacings")
     @classmethod
     def _no_duplicates(cls, spacings: tuple[float, ...]) -> tuple[float, ...]:
-        first_index: dict[float, int] = {}
-        repeats = []
-        for index, spacing in enumerate(spacings):
-            if spacing in first_index:
-                repeats.append((index, first_index[spacing], spacing))
-            else:
-                first_index[spacing] = index
-        if repeats:
-            # The mapper below turns each repeat into its own problem at its index.
-            raise PydanticCustomError(
-                "duplicate", "plant spacings repeat: {repeats}", {"repeats": repeats}
-            )
-        return spacings
+        return _no_repeats(spacings, "plant spacing")
+
+
+def _no_repeats(values: tuple[float, ...], what: str) -> tuple[float, ...]:
+    """``values`` unchanged, or a ``duplicate`` error listing every repeat (``what`` names one)."""
+    first_index: dict[float, int] = {}
+    repeats = []
+    for index, value in enumerate(values):
+        if value in first_index:
+            repeats.append((index, first_index[value], value))
+        else:
+            first_index[value] = index
+    if repeats:
+        # The mapper below turns each repeat into its own problem at its index.
+        raise PydanticCustomError(
+            "duplicate", "{what}s repeat: {repeats}", {"repeats": repeats, "what": what}
+        )
+    return values
 
 
 class _Envelope(_Table):
@@ -283,8 +331,233 @@ class PlantingParameters(_Table):
     resolution: ResolutionParameters = ResolutionParameters()
 
 
-DesignParameters = Annotated[Union[PlantingParameters], Field(discriminator="mechanism")]
-"""Every mechanism kind, told apart by ``mechanism`` (add ``"pricking"`` here)."""
+# --------------------------------------------------------------------------- kind 2: pricking
+
+_PROBLEMS = "problems"
+"""Pydantic error type of a validator that wrote its own problems (see _problems_error)."""
+
+
+def _problems_error(problems: list[tuple[tuple, str, str]]) -> PydanticCustomError:
+    """An error carrying finished problems: ``(path suffix, code, message)`` each.
+
+    The suffix is appended to the field's path (``(3,)`` makes ``trajectory.points.3``).
+    """
+    return PydanticCustomError(
+        _PROBLEMS, "{count} problem(s)", {"count": len(problems), "problems": problems}
+    )
+
+
+def _show_array(values: list | tuple) -> str:
+    return "[" + ", ".join(_show(v) for v in values) + "]"
+
+
+def _pair_issue(value: Any, label: str) -> tuple[str, str] | None:
+    """Why ``value`` is not a pair ``[x, y]`` of finite numbers, as ``(code, message)``."""
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        return "wrong_type", f"{label} must be a pair [x, y] of numbers, not {_describe(value)}"
+    for index, item in enumerate(value):
+        if isinstance(item, bool) or not isinstance(item, (int, float)):
+            text = (f"{label} must be a pair [x, y] of numbers: its item {index} is "
+                    f"{_describe(item)}")
+            if isinstance(item, str):
+                text += " (write numbers without quotes)"
+            return "wrong_type", text
+    for index, item in enumerate(value):
+        if isinstance(item, int):
+            try:
+                float(item)
+            except OverflowError:
+                return "out_of_range", (f"{label}: its item {index} = {item} is too large to be "
+                                        "represented as a float")
+        elif not math.isfinite(item):
+            return "not_finite", (f"{label} = {_show_array(value)} is not a pair of finite "
+                                  f"numbers: its item {index} is {item!r}")
+    return None
+
+
+def _check_pair(value: Any, label: str) -> Any:
+    issue = _pair_issue(value, label)
+    if issue is not None:
+        raise _problems_error([((), *issue)])
+    return (float(value[0]), float(value[1]))
+
+
+class TrajectoryParameters(_Table):
+    """The wanted needle-tip loop relative to the machine, as type-value points.
+
+    Frame: x = forward travel, y = up, mm. Only the structure is checked here; the
+    kinematic model judges the geometry (repeats, self-intersection, O inside the loop).
+    """
+
+    points: tuple[tuple[float, float], ...] = Field(
+        min_length=MIN_TYPE_VALUE_POINTS,
+        description="type-value points Q1..Qm (x, y), mm, in the loop's order",
+    )
+    degree: int = Field(description="degree of the closed interpolating curve: 3 or 5")
+    sun_centre: tuple[float, float] = Field((0.0, 0.0), description="sun-gear centre O, mm")
+
+    @field_validator("points", mode="before")
+    @classmethod
+    def _points_are_pairs(cls, points: Any, info: ValidationInfo) -> Any:
+        name = info.field_name
+        if not isinstance(points, (list, tuple)):
+            raise _problems_error([((), "wrong_type",
+                                    f"{name} must be an array of [x, y] pairs, not "
+                                    f"{_describe(points)}")])
+        problems = []
+        pairs = []
+        for index, pair in enumerate(points):
+            issue = _pair_issue(pair, f"{name}[{index}]")
+            if issue is None:
+                pairs.append((float(pair[0]), float(pair[1])))
+            else:
+                problems.append(((index,), *issue))
+        if len(points) < MIN_TYPE_VALUE_POINTS:
+            problems.insert(0, ((), "out_of_range",
+                                f"{name} has {len(points)} item{'s' if len(points) != 1 else ''}: "
+                                f"at least {MIN_TYPE_VALUE_POINTS} type-value points are needed"))
+        if problems:
+            raise _problems_error(problems)
+        return tuple(pairs)
+
+    @field_validator("sun_centre", mode="before")
+    @classmethod
+    def _sun_centre_is_a_pair(cls, centre: Any, info: ValidationInfo) -> Any:
+        return _check_pair(centre, info.field_name)
+
+    @field_validator("degree")
+    @classmethod
+    def _degree_allowed(cls, degree: int) -> int:
+        if degree not in TRAJECTORY_DEGREES:
+            allowed = " or ".join(str(d) for d in TRAJECTORY_DEGREES)
+            raise PydanticCustomError(
+                "not_allowed",
+                "degree = {degree} is not allowed: it must be {allowed}",
+                {"degree": degree, "allowed": allowed},
+            )
+        return degree
+
+
+class LinkageParameters(_Table):
+    """Rocker arm, and optional expert overrides of the lengths the curve normally sets."""
+
+    rocker: float = Field(gt=0, description="l1, rocker arm length, mm")
+    centre_distance: float | None = Field(
+        None, gt=0, description="a, centre distance of every gear pair, mm (normally derived)"
+    )
+    tip_reach: float | None = Field(
+        None, gt=0, description="l, planet centre B to the needle tip D, mm (normally derived)"
+    )
+
+
+SplitExponent = Union[Literal["equal-perimeter"], float]
+"""``gears.split_exponent``: ``"equal-perimeter"`` or a number w in [0, 4]."""
+
+
+class GearParameters(_Table):
+    """How the total relative ratio is split into two stages, and the gear cutting data."""
+
+    split_exponent: SplitExponent = Field(
+        EQUAL_PERIMETER,
+        description='w in i1 = K i^w: "equal-perimeter" or a number in [0, 4]',
+    )
+    module: float = Field(2.0, gt=0, description="target module m, mm")
+    pressure_angle_deg: float = Field(20.0, gt=0, lt=45, description="pressure angle, deg")
+    addendum: float = Field(1.0, gt=0, description="addendum coefficient ha*, dimensionless")
+    min_ratio: float = Field(
+        0.05, gt=0, description="lower bound of the total relative ratio i, dimensionless"
+    )
+
+    @field_validator("split_exponent", mode="before")
+    @classmethod
+    def _split_exponent(cls, value: Any, info: ValidationInfo) -> Any:
+        name = info.field_name
+        low, high = SPLIT_EXPONENT_RANGE
+        choices = f'{_show(EQUAL_PERIMETER)} or a number from {low:g} to {high:g}'
+        if isinstance(value, str):
+            if value == EQUAL_PERIMETER:
+                return value
+            try:
+                float(value)
+            except ValueError:
+                text = f"{name} = {_show(value)} is not allowed: it must be {choices}"
+                if _close_keys(value, [EQUAL_PERIMETER], cutoff=0.4):
+                    text += f"; did you mean {_show(EQUAL_PERIMETER)}?"
+                raise _problems_error([((), "not_allowed", text)]) from None
+            raise _problems_error([((), "wrong_type",
+                                    f"{name} must be {choices}, not {_describe(value)} "
+                                    "(write numbers without quotes)")])
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise _problems_error([((), "wrong_type",
+                                    f"{name} must be {choices}, not {_describe(value)}")])
+        try:
+            number = float(value)
+        except OverflowError:
+            raise _problems_error([((), "out_of_range",
+                                    f"{name} = {value} is too large to be represented as a "
+                                    "float")]) from None
+        if not math.isfinite(number):
+            raise _problems_error([((), "not_finite",
+                                    f"{name} = {_show(value)} is not a finite number")])
+        if not low <= number <= high:
+            raise _problems_error([((), "out_of_range",
+                                    f"{name} = {_show(value)} is out of range: it must be "
+                                    f"from {low:g} to {high:g}")])
+        return number
+
+    @property
+    def pressure_angle_rad(self) -> float:
+        """The pressure angle in radians."""
+        return math.radians(self.pressure_angle_deg)
+
+
+class PrickingFieldParameters(_Table):
+    """Operating case: speeds, vertical pricking depth, inclinations of the mechanism plane."""
+
+    carrier_speed_rpm: float = Field(75.0, gt=0, description="carrier speed omega, r/min")
+    forward_speed: float = Field(gt=0, description="machine speed v, mm/s")
+    depth: float = Field(gt=0, description="vertical pricking depth, mm")
+    inclinations_deg: Annotated[
+        tuple[Annotated[float, Field(ge=0, lt=INCLINATION_MAX_DEG)], ...],
+        BeforeValidator(_list_to_tuple),
+    ] = Field(min_length=1, description="inclinations theta of the mechanism plane, deg")
+
+    @field_validator("inclinations_deg")
+    @classmethod
+    def _no_duplicates(cls, inclinations: tuple[float, ...]) -> tuple[float, ...]:
+        return _no_repeats(inclinations, "inclination")
+
+    @property
+    def inclinations_rad(self) -> tuple[float, ...]:
+        """The inclinations theta in radians."""
+        return tuple(math.radians(theta) for theta in self.inclinations_deg)
+
+
+class PrickingResolutionParameters(_Table):
+    """Numerical resolution knobs of the inverse design."""
+
+    inverse_grid: int = Field(
+        720, ge=INVERSE_GRID_RANGE[0], le=INVERSE_GRID_RANGE[1],
+        description="uniform carrier-angle samples per turn of the inverse solve",
+    )
+
+
+class PrickingParameters(_Table):
+    """Mechanism kind 2: the inclined hole-pricking mechanism, designed from its tip loop."""
+
+    mechanism: Literal["pricking"]
+    name: str = Field(pattern=NAME_PATTERN, min_length=1, max_length=NAME_MAX_LENGTH)
+    trajectory: TrajectoryParameters
+    linkage: LinkageParameters
+    gears: GearParameters = GearParameters()
+    field: PrickingFieldParameters
+    resolution: PrickingResolutionParameters = PrickingResolutionParameters()
+
+
+DesignParameters = Annotated[
+    Union[PlantingParameters, PrickingParameters], Field(discriminator="mechanism")
+]
+"""Every mechanism kind, told apart by ``mechanism``."""
 
 _DESIGN_ADAPTER = TypeAdapter(DesignParameters)
 
@@ -433,7 +706,7 @@ _RELATIONS = {
     "less_than_equal": ("le", "at most"),
 }
 
-_CUSTOM_CODES = {"inconsistent"}
+_CUSTOM_CODES = {"inconsistent", "not_allowed"}
 
 
 def _problems_from_error(error: Mapping[str, Any]) -> list[Problem]:
@@ -509,6 +782,12 @@ def _problems_from_error(error: Mapping[str, Any]) -> list[Problem]:
                         f"{NAME_MAX_LENGTH} characters, start with a letter or digit and "
                         "contain only letters, digits, '.', '_' and '-'")]
 
+    if (kind == "too_short" and isinstance(value, (list, tuple))
+            and len(value) >= ctx.get("min_length", 0)):
+        # pydantic counts the items that passed: the array was long enough, and each
+        # item that failed is already reported at its own index.
+        return []
+
     if kind == "too_short" and ctx.get("min_length") == 1:
         return [Problem(path, "empty", f"{name} must not be empty")]
 
@@ -520,12 +799,19 @@ def _problems_from_error(error: Mapping[str, Any]) -> list[Problem]:
         return [
             Problem(f"{path}.{index}", "duplicate",
                     f"{name}[{index}] = {_show(spacing)} repeats {name}[{first}]; "
-                    "give each plant spacing once")
+                    f"give each {ctx.get('what', 'value')} once")
             for index, first, spacing in ctx["repeats"]
         ]
 
     if kind in _CUSTOM_CODES:
         return [Problem(path, kind, error["msg"])]
+
+    if kind == _PROBLEMS:
+        # A validator that wrote its problems itself (see _problems_error).
+        return [
+            Problem(_table_name(parts + list(suffix)), code, message)
+            for suffix, code, message in ctx["problems"]
+        ]
 
     if kind == "literal_error":
         expected = ctx.get("expected")
@@ -562,7 +848,7 @@ def _feasibility_problems(params: Any) -> list[Problem]:
 
 def validate_data(
     data: Mapping[str, Any], source: str | None = None, *, check_feasibility: bool = True
-) -> PlantingParameters:
+) -> PlantingParameters | PrickingParameters:
     """Validate an already-parsed parameter mapping.
 
     Parameters
@@ -577,8 +863,9 @@ def validate_data(
 
     Returns
     -------
-    PlantingParameters
-        The validated, frozen parameters (a member of :data:`DesignParameters`).
+    PlantingParameters or PrickingParameters
+        The validated, frozen parameters (the member of :data:`DesignParameters`
+        that ``mechanism`` names).
 
     Raises
     ------
@@ -611,7 +898,7 @@ def _syntax_problem(exc: tomllib.TOMLDecodeError) -> Problem:
 
 def validate_text(
     text: str, source: str | None = None, *, check_feasibility: bool = True
-) -> PlantingParameters:
+) -> PlantingParameters | PrickingParameters:
     """Parse and validate the text of a parameter file.
 
     Parameters
@@ -625,7 +912,7 @@ def validate_text(
 
     Returns
     -------
-    PlantingParameters
+    PlantingParameters or PrickingParameters
         The validated, frozen parameters.
 
     Raises
@@ -641,7 +928,9 @@ def validate_text(
     return validate_data(data, source, check_feasibility=check_feasibility)
 
 
-def load_params(path: str | Path, *, check_feasibility: bool = True) -> PlantingParameters:
+def load_params(
+    path: str | Path, *, check_feasibility: bool = True
+) -> PlantingParameters | PrickingParameters:
     """Read, parse and validate a parameter file.
 
     Parameters
@@ -653,7 +942,7 @@ def load_params(path: str | Path, *, check_feasibility: bool = True) -> Planting
 
     Returns
     -------
-    PlantingParameters
+    PlantingParameters or PrickingParameters
         The validated, frozen parameters.
 
     Raises

@@ -1,0 +1,141 @@
+"""Piecewise Chebyshev interpolants: spectral derivatives and integrals of piecewise-smooth functions.
+
+A function that is analytic on each piece of a partition (a spline span, split
+again at a mechanism's dead centres) is interpolated at Chebyshev points of the
+first kind on every piece; a piece whose trailing coefficients have not decayed
+to ``rtol`` is halved and fitted again. Derivatives and antiderivatives are
+exact operations on the coefficients. The nodes never sit on a break point,
+where such functions are typically evaluated least accurately.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import chebyshev as cheb
+
+from .errors import ConvergenceError
+
+__all__ = ["PiecewiseChebyshev"]
+
+
+def _first_kind_nodes(degree: int) -> np.ndarray:
+    k = np.arange(degree + 1)
+    return np.cos(np.pi * (k + 0.5) / (degree + 1))[::-1]
+
+
+def _transform(degree: int) -> np.ndarray:
+    """Matrix taking values at the first-kind nodes to Chebyshev coefficients."""
+    x = _first_kind_nodes(degree)
+    basis = np.cos(np.outer(np.arccos(x), np.arange(degree + 1)))  # T_j(x_k)
+    matrix = basis * (2.0 / (degree + 1))
+    matrix[:, 0] *= 0.5
+    return matrix
+
+
+@dataclass(frozen=True)
+class PiecewiseChebyshev:
+    """A scalar function on ``[breaks[0], breaks[-1]]``, one Chebyshev series per piece.
+
+    Attributes
+    ----------
+    breaks : (p + 1,) float
+        Increasing piece boundaries.
+    coefficients : (p, n + 1) float
+        Chebyshev coefficients of each piece on its own ``[-1, 1]``.
+    """
+
+    breaks: np.ndarray
+    coefficients: np.ndarray
+
+    @classmethod
+    def interpolate(cls, function, breaks, *, degree: int = 24, rtol: float = 1e-13,
+                    max_pieces: int = 4096, min_width: float = 1e-7) -> "PiecewiseChebyshev":
+        """Fit ``function`` (vectorized) on every piece, halving pieces until converged.
+
+        A piece narrower than ``min_width`` times the domain is accepted as it is:
+        there the function's own round-off (an arccos next to +-1, say) is what
+        the tail shows, and halving further would only chase it.
+
+        Raises
+        ------
+        ConvergenceError
+            If more than ``max_pieces`` pieces would be needed (the function is
+            not piecewise smooth on the given breaks).
+        """
+        breaks = np.asarray(breaks, dtype=float)
+        if breaks.ndim != 1 or breaks.size < 2 or np.any(np.diff(breaks) <= 0):
+            raise ValueError("breaks must be a strictly increasing 1-D array of at least 2 values")
+        nodes = _first_kind_nodes(degree)
+        transform = _transform(degree)
+        lows, highs = breaks[:-1], breaks[1:]
+        done_lows, done_highs, done_coefficients = [], [], []
+        scale = None
+        while lows.size:
+            points = 0.5 * (lows + highs)[:, None] + 0.5 * (highs - lows)[:, None] * nodes
+            values = np.asarray(function(points.ravel()), dtype=float).reshape(points.shape)
+            if not np.all(np.isfinite(values)):
+                raise ConvergenceError("function is not finite on the interpolation nodes")
+            if scale is None:
+                scale = max(float(np.abs(values).max()), 1e-300)
+            coefficients = values @ transform
+            tail = np.abs(coefficients[:, -3:]).max(axis=1)
+            good = (tail <= rtol * scale) | (highs - lows <= min_width * (breaks[-1] - breaks[0]))
+            done_lows.append(lows[good])
+            done_highs.append(highs[good])
+            done_coefficients.append(coefficients[good])
+            middle = 0.5 * (lows[~good] + highs[~good])
+            lows = np.concatenate([lows[~good], middle])
+            highs = np.concatenate([middle, highs[~good]])
+            if sum(len(x) for x in done_lows) + lows.size > max_pieces:
+                raise ConvergenceError(
+                    f"Chebyshev interpolation needs more than {max_pieces} pieces")
+        lows = np.concatenate(done_lows)
+        order = np.argsort(lows)
+        edges = np.append(lows[order], np.concatenate(done_highs)[order][-1])
+        return cls(edges, np.concatenate(done_coefficients)[order])
+
+    # ------------------------------------------------------------ evaluation
+    def _locate(self, u):
+        u = np.asarray(u, dtype=float)
+        piece = np.clip(np.searchsorted(self.breaks, u, side="right") - 1,
+                        0, len(self.coefficients) - 1)
+        low, high = self.breaks[piece], self.breaks[piece + 1]
+        return u, piece, (2.0 * u - low - high) / (high - low)
+
+    def __call__(self, u):
+        """Values at ``u`` (any shape); points outside extend the end pieces."""
+        u, piece, x = self._locate(u)
+        rows = self.coefficients[piece]
+        # Clenshaw's recurrence, vectorized over points with their own coefficient rows
+        b1 = np.zeros_like(x)
+        b2 = np.zeros_like(x)
+        for j in range(rows.shape[-1] - 1, 0, -1):
+            b1, b2 = 2.0 * x * b1 - b2 + rows[..., j], b1
+        return x * b1 - b2 + rows[..., 0]
+
+    def derivative(self) -> "PiecewiseChebyshev":
+        widths = np.diff(self.breaks)[:, None]
+        rows = [cheb.chebder(c) for c in self.coefficients]
+        derived = np.array([np.append(r, 0.0) for r in rows]) * (2.0 / widths)
+        return PiecewiseChebyshev(self.breaks, derived)
+
+    def antiderivative(self) -> "PiecewiseChebyshev":
+        """The continuous antiderivative that is zero at ``breaks[0]``."""
+        widths = np.diff(self.breaks)
+        rows = np.array([cheb.chebint(c, lbnd=-1) for c in self.coefficients])
+        rows *= (0.5 * widths)[:, None]
+        totals = np.array([cheb.chebval(1.0, r) for r in rows])
+        rows[:, 0] += np.concatenate([[0.0], np.cumsum(totals)[:-1]])
+        return PiecewiseChebyshev(self.breaks, rows)
+
+    def integral(self) -> float:
+        """Definite integral over the whole domain."""
+        widths = np.diff(self.breaks)
+        rows = [cheb.chebint(c, lbnd=-1) for c in self.coefficients]
+        return float(sum(0.5 * w * cheb.chebval(1.0, r) for w, r in zip(widths, rows)))
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        return float(self.breaks[0]), float(self.breaks[-1])
