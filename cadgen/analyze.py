@@ -25,7 +25,13 @@ class AnalysisResult:
     files: list = field(default_factory=list)
 
     def summary_text(self) -> str:
-        return format_metrics_table(self.report) + (
+        if self.report["mechanism"] == "pricking":
+            from .pricking_report import pricking_summary
+
+            text = pricking_summary(self.report)
+        else:
+            text = format_metrics_table(self.report)
+        return text + (
             f"\nwrote {len(self.files)} files to {self.output_dir}" if self.output_dir else "")
 
 
@@ -158,21 +164,11 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
 
     With ``output_root=None`` nothing is written (the report is still returned).
     """
-    from .design import build_mechanism, evaluate
-
-    timings: dict = {}
-    with _stage(timings, "kinematics"):
-        mechanism = build_mechanism(params)
-        mechanism.closure  # solve the closure inside its own stage
-    with _stage(timings, "metrics"):
-        evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
-    figures = {}
-    if plots and output_root is not None:
-        with _stage(timings, "plots"):
-            from .plots import planting_figures
-
-            figures = planting_figures(mechanism, evaluation)
-    report = report_dict(params, mechanism, evaluation, timings)
+    if params.mechanism == "pricking":
+        report, figures = _pricking(params, plots and output_root is not None)
+    else:
+        report, figures = _planting(params, steps_per_revolution,
+                                    plots and output_root is not None)
     if output_root is None:
         return AnalysisResult(params.name, report, None)
     from .atomic import staged_directory
@@ -187,6 +183,43 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
         (staging / "report.json").write_text(json.dumps(report, indent=2, default=_jsonable) + "\n")
         files.append("report.json")
     return AnalysisResult(params.name, report, final, sorted(files))
+
+
+def _planting(params, steps_per_revolution, plots):
+    from .design import build_mechanism, evaluate
+
+    timings: dict = {}
+    with _stage(timings, "kinematics"):
+        mechanism = build_mechanism(params)
+        mechanism.closure  # solve the closure inside its own stage
+    with _stage(timings, "metrics"):
+        evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
+    figures = {}
+    if plots:
+        with _stage(timings, "plots"):
+            from .plots import planting_figures
+
+            figures = planting_figures(mechanism, evaluation)
+    return report_dict(params, mechanism, evaluation, timings), figures
+
+
+def _pricking(params, plots):
+    from .design import pricking_design, pricking_field
+    from .pricking_report import pricking_report
+
+    timings: dict = {}
+    with _stage(timings, "inverse_design"):
+        design = pricking_design(params)
+    with _stage(timings, "field"):
+        field = pricking_field(params, design)
+    figures = {}
+    if plots:
+        with _stage(timings, "plots"):
+            from .plots_pricking import pricking_figures
+
+            figures = pricking_figures(params, design, field)
+    report = pricking_report(params, design, field, timings, _versions(), input_hash(params))
+    return report, figures
 
 
 def _jsonable(value):

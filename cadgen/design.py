@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import math
+from functools import lru_cache
+
+import numpy as np
 
 from kinematics.clearance import HousingCircle
 from kinematics.evaluation import Targets, default_housing_circles, evaluate_planting
 from kinematics.pitch_curves import LimaconPitchCurve
 from kinematics.planting import PlantingMechanism
 
-__all__ = ["build_mechanism", "housing_circles", "targets_of", "evaluate"]
+__all__ = ["build_mechanism", "housing_circles", "targets_of", "evaluate", "pricking_design",
+           "pricking_field"]
 
 
 def build_mechanism(params) -> PlantingMechanism:
@@ -51,3 +55,29 @@ def evaluate(params, mechanism: PlantingMechanism | None = None, steps: int | No
         housing_circles=housing_circles(params, mechanism, module),
         targets=targets_of(params),
         steps=steps or params.resolution.steps_per_revolution)
+
+
+@lru_cache(maxsize=16)
+def pricking_design(params):
+    """The inverse design of a validated pricking file (cached: validation and analysis share it)."""
+    from kinematics.pricking import design_pricking
+
+    trajectory, gears = params.trajectory, params.gears
+    return design_pricking(
+        np.asarray(trajectory.points, dtype=float), rocker=params.linkage.rocker,
+        degree=trajectory.degree, centre=trajectory.sun_centre,
+        a=params.linkage.centre_distance, l=params.linkage.tip_reach,
+        exponent=gears.split_exponent, module=gears.module,
+        pressure_angle=gears.pressure_angle_rad, addendum=gears.addendum,
+        min_ratio=gears.min_ratio, grid=params.resolution.inverse_grid)
+
+
+def pricking_field(params, design=None):
+    """Field figures of a pricking design at every inclination of the file."""
+    from kinematics.pricking_field import field_motion
+
+    design = design or pricking_design(params)
+    field = params.field
+    return field_motion(design, carrier_speed_rpm=field.carrier_speed_rpm,
+                        forward_speed=field.forward_speed, depth=field.depth,
+                        inclinations_deg=field.inclinations_deg)

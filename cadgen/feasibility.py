@@ -22,8 +22,8 @@ def design_problems(params) -> list:
     gears' smallest radii clear the cutting limit for the module; the planting
     depth leaves the tip a way out of the soil.
     """
-    if getattr(params, "mechanism", "planting") != "planting":
-        return []
+    if params.mechanism == "pricking":
+        return _pricking_problems(params)
     from .design import build_mechanism
 
     try:
@@ -46,3 +46,17 @@ def design_problems(params) -> list:
             f"planting depth {params.field.depth:g} mm is not less than the tip path's height "
             f"{height:.3f} mm: the tip never leaves the soil"))
     return problems
+
+
+def _pricking_problems(params) -> list:
+    """Run the inverse design and the field check; their specific errors are the problems."""
+    from .design import pricking_design, pricking_field
+
+    try:
+        design = pricking_design(params)
+        pricking_field(params, design)
+    except DesignError as error:
+        return list(error.problems)
+    except ConvergenceError as error:
+        return [Problem("trajectory.points", "not_converged", str(error))]
+    return []

@@ -488,21 +488,18 @@ def equal_perimeter_exponent(geometry: _StageGeometry) -> float:
 
 
 def _stretches(v, mask, geometry, curve, motion):
-    """Contiguous runs of ``mask`` over the samples, described in carrier degrees and points."""
+    """Contiguous runs of ``mask`` over the samples, in carrier progress (deg) and type-value points."""
     runs = []
     if not mask.any():
         return runs
     edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-    phi1 = motion.phi1(v)
+    progress = np.degrees(motion.sense * (motion.phi1(v) - motion.phi1(0.0)))
     for start, stop in zip(edges[::2], edges[1::2]):
-        segment = slice(start, stop)
-        runs.append({
-            "carrier_deg": [float(np.degrees(phi1[start])), float(np.degrees(phi1[stop - 1]))],
-            "near": curve.describe(motion.linkage.u_max + v[start]) if start == stop - 1 else
-            f"{curve.describe(motion.linkage.u_max + v[start])} to "
-            f"{curve.describe(motion.linkage.u_max + v[stop - 1])}",
-            "samples": int(stop - start),
-        })
+        first = curve.describe(motion.linkage.u_max + v[start])
+        last = curve.describe(motion.linkage.u_max + v[stop - 1])
+        runs.append({"carrier_deg": [float(progress[start]), float(progress[stop - 1])],
+                     "near": first if first == last else f"{first} to {last}",
+                     "samples": int(stop - start)})
     return runs
 
 
@@ -686,8 +683,9 @@ def _findings(stages, curve):
     for stage in stages:
         for gear in (stage.drive, stage.driven):
             if not gear.convex:
-                where = "; ".join(f"carrier {s['carrier_deg'][0]:.1f} to {s['carrier_deg'][1]:.1f} "
-                                  f"deg (tip near {s['near']})" for s in gear.concave_stretches)
+                where = "; ".join(f"carrier progress {s['carrier_deg'][0]:.1f} to "
+                                  f"{s['carrier_deg'][1]:.1f} deg (tip near {s['near']})"
+                                  for s in gear.concave_stretches)
                 advice = ("use the degree-5 curve, or move the type-value points there onto a "
                           "smoother loop" if curve.degree == 3 else
                           "move the type-value points there onto a smoother loop")

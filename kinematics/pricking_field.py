@@ -78,6 +78,8 @@ class InclinationResult:
     projected_height: float
     width: float
     needle_root_in_soil: bool
+    entry_parameter: float = 0.0
+    exit_parameter: float = 0.0
 
 
 class _FieldModel:
@@ -189,7 +191,8 @@ def field_motion(design: PrickingDesign, *, carrier_speed_rpm: float, forward_sp
             hole_mouth=mouth[1] - mouth[0], mouth_range=mouth,
             slow_windows_deg=slow, slow_window_total_deg=float(sum(b - a for a, b in slow)),
             projected_height=float((y_max - y_min) * np.cos(theta)), width=width,
-            needle_root_in_soil=bool((~above).any())))
+            needle_root_in_soil=bool((~above).any()),
+            entry_parameter=float(entry), exit_parameter=float(leave)))
     return results
 
 

@@ -181,8 +181,27 @@ class ClosedCurve:
                     options={"xatol": 1e-12 * self.period})
                 if res.fun < best_v:
                     best_u, best_v = float(res.x), float(res.fun)
+            best_u = self._stationary(best_u, centre, width=2 * step)
+            best_v = sign * float(np.linalg.norm(self(best_u) - centre))
             results.append((float(np.mod(best_u, self.period)), sign * best_v))
         return results[0], results[1]
+
+    def _stationary(self, guess: float, centre, width: float) -> float:
+        """Polish an extremum of R as the root of ``dR/du ~ (p - O).p'``.
+
+        A minimiser pins a flat extremum's location only to about sqrt(eps);
+        the slope has a simple root there, which bisection finds to round-off
+        (the dead centres must be exact: the branch of the arccos flips there).
+        """
+        from scipy.optimize import brentq
+
+        def slope(u):
+            return float(np.dot(self(u) - centre, self(u, 1)))
+
+        low, high = guess - width, guess + width
+        if slope(low) * slope(high) < 0:
+            return brentq(slope, low, high, xtol=1e-15 * self.period, rtol=1e-15)
+        return guess
 
     def centre_problems(self, centre, path: str = "trajectory.sun_centre") -> list:
         """The sun centre must lie outside the loop (else no tip annulus contains the loop)."""

@@ -54,3 +54,18 @@ def test_same_input_same_hash(params):
     second = run_analysis(params, output_root=None)
     assert first.report["input_sha256"] == second.report["input_sha256"]
     assert first.report["metrics"] == second.report["metrics"]
+
+
+def test_pricking_report_says_where_the_gears_are_concave(tmp_path):
+    params = load_params(REFERENCE.parent / "kernel-a.toml")
+    result = run_analysis(params, output_root=tmp_path)
+    folder = tmp_path / "kernel-a"
+    assert sorted(p.name for p in (folder / "plots").iterdir()) == [
+        "field_paths.png", "loop.png", "pitch_curves.png", "ratio.png"]
+    report = json.loads((folder / "report.json").read_text())
+    assert report["verified"] is True
+    assert {f["code"] for f in report["findings"]} >= {"concave_pitch_curve"}
+    assert [g["convex"] for g in report["gears"]["pitch_curves"]] == [False] * 4
+    assert len(report["field"]["per_inclination"]) == 3
+    text = result.summary_text()
+    assert "concave" in text and "near Q" in text

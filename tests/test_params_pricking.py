@@ -173,7 +173,7 @@ def test_kernel_a_loads_with_the_spec_values():
     assert math.isclose(gears.pressure_angle_rad, math.radians(20.0))
     field = params.field
     assert isinstance(field, PrickingFieldParameters)
-    assert (field.carrier_speed_rpm, field.forward_speed, field.depth) == (75.0, 500.0, 70.0)
+    assert (field.carrier_speed_rpm, field.forward_speed, field.depth) == (75.0, 530.0, 70.0)
     assert field.inclinations_deg == (6.5, 20.0, 33.5)
     assert field.inclinations_rad == pytest.approx(tuple(map(math.radians, (6.5, 20.0, 33.5))))
     assert isinstance(params.resolution, PrickingResolutionParameters)
@@ -189,7 +189,7 @@ def test_kernel_b_loads_with_the_spec_values():
     assert params.trajectory.sun_centre == (0.0, 0.0)
     assert params.linkage.rocker == 45.0
     assert params.field.carrier_speed_rpm == 75.0
-    assert params.field.forward_speed == 500.0 and params.field.depth == 70.0
+    assert params.field.forward_speed == 600.0 and params.field.depth == 70.0
     assert params.field.inclinations_deg == (6.5, 20.0, 33.5)
 
 
