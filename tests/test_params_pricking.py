@@ -193,9 +193,12 @@ def test_kernel_b_loads_with_the_spec_values():
     assert params.field.inclinations_deg == (6.5, 20.0, 33.5)
 
 
-def test_the_two_examples_differ_only_in_name_points_and_degree():
+def test_the_two_examples_differ_only_in_name_points_degree_and_speed():
     a, b = load_params(KERNEL_A), load_params(KERNEL_B)
     same = {"mechanism", "linkage", "gears", "field", "resolution"}
+    # forward speeds differ: each is set so its tip is nearly still over the ground at the bottom
+    assert (a.field.forward_speed, b.field.forward_speed) == (530.0, 600.0)
+    b = b.model_copy(update={"field": b.field.model_copy(update={"forward_speed": 530.0})})
     assert all(getattr(a, key) == getattr(b, key) for key in same)
     assert a.trajectory.sun_centre == b.trajectory.sun_centre
     assert set(PrickingParameters.model_fields) == same | {"name", "trajectory"}
@@ -431,7 +434,7 @@ def test_unknown_mechanism_lists_both_kinds():
 
 
 def test_optional_keys_and_tables_take_the_defaults():
-    params = validate_text(MINIMAL)
+    params = validate_text(_with(MINIMAL, "forward_speed", "530.0"))
     assert params == load_params(KERNEL_A)  # the example spells out every default
 
 
@@ -444,7 +447,10 @@ def test_split_exponent_numbers_are_accepted_as_floats(value):
 
 @pytest.mark.parametrize("theta", ["0", "0.0", "79.9"])
 def test_inclination_bounds(theta):
-    params = validate_text(_minimal_with("inclinations_deg", f"[{theta}]"))
+    # structure only: at 79.9 deg the 70 mm depth is 400 mm in the mechanism plane, deeper than
+    # the loop, which the feasibility check reports (next test)
+    params = validate_text(_minimal_with("inclinations_deg", f"[{theta}]"),
+                           check_feasibility=False)
     assert params.field.inclinations_deg == (float(theta),)
 
 
@@ -464,14 +470,24 @@ def test_integers_are_accepted_for_floats_and_stored_as_floats():
     assert params.field.inclinations_deg == (20.0, 6.0)  # order kept, not sorted
 
 
-def test_exactly_five_points_and_degree_5_are_accepted():
-    params = validate_text(_with(_minimal_with("points", f"[{FIVE}]"), "degree", "5"))
+def test_steep_inclination_deeper_than_the_loop_is_infeasible():
+    with pytest.raises(ParameterError) as caught:
+        validate_text(_minimal_with("inclinations_deg", "[79.9]"))
+    assert _pairs(caught.value.problems) == {("field.depth", "no_soil_crossing")}
+
+
+def test_exactly_five_points_and_degree_5_pass_the_schema_but_not_the_curve():
+    text = _with(_minimal_with("points", f"[{FIVE}]"), "degree", "5")
+    params = validate_text(text, check_feasibility=False)
     assert len(params.trajectory.points) == 5 and params.trajectory.degree == 5
+    with pytest.raises(ParameterError) as caught:  # a quintic closed curve needs 7 points
+        validate_text(text)
+    assert _pairs(caught.value.problems) == {("trajectory.points", "too_few_points")}
 
 
 def test_expert_overrides_of_the_link_lengths():
     text = _added(MINIMAL, "linkage", "centre_distance = 55\ntip_reach = 180.5")
-    linkage = validate_text(text).linkage
+    linkage = validate_text(text, check_feasibility=False).linkage
     assert (linkage.rocker, linkage.centre_distance, linkage.tip_reach) == (45.0, 55.0, 180.5)
     assert type(linkage.centre_distance) is float
 
