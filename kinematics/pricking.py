@@ -731,6 +731,8 @@ def design_pricking(points, *, rocker: float, degree: int = 3, centre=(0.0, 0.0)
                    min_ratio=min_ratio, grid=grid, sense=sense)
     first = _design_once(points, **options)
     perimeter = first[5][0].perimeter
+    # scaling about O leaves every angle, hence the ratio law and its split, unchanged
+    options["exponent"] = first[4]
     teeth_1 = max(min_teeth, int(round(perimeter / (np.pi * module))))
     scale = teeth_1 * np.pi * module / perimeter
     if a is not None:
