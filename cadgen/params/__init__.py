@@ -1,0 +1,141 @@
+"""Parameter files: TOML format, schema and all-problems-at-once validation.
+
+A parameter file names its mechanism kind and holds one table per part of the design:
+
+* ``mechanism = "planting"`` (kind 1, :class:`PlantingParameters`): the differential
+  planetary planting mechanism, tables ``[pitch_curve]``, ``[train]``, ``[planter]``,
+  ``[field]`` and the optional ``[housing]``, ``[targets]``, ``[resolution]``;
+* ``mechanism = "pricking"`` (kind 2, :class:`PrickingParameters`): the inclined
+  hole-pricking mechanism, inverse-designed from its needle-tip loop, tables
+  ``[trajectory]``, ``[linkage]``, ``[field]`` and the optional ``[gears]``,
+  ``[resolution]``. Only the structure of the type-value points is checked here
+  (at least 5 pairs of finite numbers); their geometry (repeated points,
+  self-intersection, the sun centre inside the loop) is the kinematic model's to judge.
+
+The schema is a set of frozen pydantic models, strict about types (a quoted ``"36"``
+is not a number, ``true`` is not a number, an integer is accepted where a float is
+asked), finite floats only, and no unknown keys. :func:`load_params` and
+:func:`validate_text` never stop at the first problem: they raise one
+:class:`ParameterError` that lists every problem found, each a
+:class:`~kinematics.errors.Problem` with a dotted field path (``train.R``,
+``field.plant_spacings.1``), a short code and a sentence naming the bad value.
+
+Problem codes raised here:
+
+==================  =====================================================================
+code                meaning
+==================  =====================================================================
+file_not_found      the file does not exist
+not_readable        the path is a directory or cannot be read
+not_utf8            the file is not UTF-8 text
+toml_syntax         the text is not valid TOML (message has line and column)
+missing             a required key or table is absent
+unknown_key         a key or table the schema does not know (with "did you mean")
+wrong_type          e.g. a string or boolean where a number is asked
+out_of_range        a number outside its allowed interval
+not_finite          nan or inf
+empty               an array that must not be empty
+invalid_name        the design name cannot name an output folder
+unknown_mechanism   ``mechanism`` names no known mechanism kind
+unknown_kind        a ``kind`` (e.g. ``pitch_curve.kind``) names no known kind
+inconsistent        a value contradicts a rule that needs no kinematics (``2*e2`` whole)
+duplicate           a plant spacing or an inclination given twice (reported at the repeat)
+not_allowed         a value outside a fixed set of choices: ``trajectory.degree`` not 3 or 5,
+                    ``gears.split_exponent`` a string other than ``"equal-perimeter"``
+==================  =====================================================================
+
+Where array problems are reported: an array item at its index
+(``field.inclinations_deg.1``); a type-value point that is not a pair of two finite
+numbers once, at the point's index (``trajectory.points.3``: ``wrong_type`` for a
+wrong shape or a non-number item, ``not_finite`` for nan or inf); too few points at
+the array itself (``trajectory.points``, ``out_of_range``).
+
+Once the file is structurally valid, :func:`cadgen.feasibility.design_problems`
+adds the problems that need the kinematic model (their codes are its own).
+Validation never writes anything.
+
+Modules: :mod:`~cadgen.params.planting` and :mod:`~cadgen.params.pricking` (the tables
+of each mechanism kind), :mod:`~cadgen.params.loading` (reading, parsing, validating,
+:class:`ParameterError`), ``_problems`` (pydantic errors to problems and their
+sentences) and ``_tables`` (the base model and shared validators). The public names
+are re-exported here: import them from :mod:`cadgen.params`.
+"""
+
+from __future__ import annotations
+
+from ._tables import NAME_PATTERN
+from .loading import (
+    MECHANISM_KINDS,
+    DesignParameters,
+    ParameterError,
+    load_params,
+    validate_data,
+    validate_text,
+)
+from .planting import (
+    CLOSURE_RTOL_RANGE,
+    MIN_TEETH,
+    STEPS_PER_REVOLUTION_RANGE,
+    DesignTargets,
+    FieldParameters,
+    Gearbox1Envelope,
+    Gearbox2Envelope,
+    HousingParameters,
+    LimaconParameters,
+    PitchCurve,
+    PlanterParameters,
+    PlantingParameters,
+    ResolutionParameters,
+    TrainParameters,
+)
+from .pricking import (
+    EQUAL_PERIMETER,
+    INCLINATION_MAX_DEG,
+    INVERSE_GRID_RANGE,
+    MIN_TYPE_VALUE_POINTS,
+    SPLIT_EXPONENT_RANGE,
+    TRAJECTORY_DEGREES,
+    GearParameters,
+    LinkageParameters,
+    PrickingFieldParameters,
+    PrickingParameters,
+    PrickingResolutionParameters,
+    SplitExponent,
+    TrajectoryParameters,
+)
+__all__ = [
+    "ParameterError",
+    "LimaconParameters",
+    "PitchCurve",
+    "TrainParameters",
+    "PlanterParameters",
+    "FieldParameters",
+    "Gearbox1Envelope",
+    "Gearbox2Envelope",
+    "HousingParameters",
+    "DesignTargets",
+    "ResolutionParameters",
+    "PlantingParameters",
+    "TrajectoryParameters",
+    "LinkageParameters",
+    "GearParameters",
+    "PrickingFieldParameters",
+    "PrickingResolutionParameters",
+    "PrickingParameters",
+    "SplitExponent",
+    "DesignParameters",
+    "MECHANISM_KINDS",
+    "NAME_PATTERN",
+    "MIN_TEETH",
+    "STEPS_PER_REVOLUTION_RANGE",
+    "CLOSURE_RTOL_RANGE",
+    "EQUAL_PERIMETER",
+    "TRAJECTORY_DEGREES",
+    "MIN_TYPE_VALUE_POINTS",
+    "SPLIT_EXPONENT_RANGE",
+    "INCLINATION_MAX_DEG",
+    "INVERSE_GRID_RANGE",
+    "load_params",
+    "validate_text",
+    "validate_data",
+]

@@ -1,0 +1,209 @@
+"""Loading a parameter file: read, parse the TOML, validate, report every problem at once.
+
+:func:`load_params` (a file), :func:`validate_text` (TOML text) and
+:func:`validate_data` (a parsed mapping) never stop at the first problem: they raise
+one :class:`ParameterError` that lists every problem found. The file is validated
+against :data:`DesignParameters`, the union of the mechanism kinds told apart by
+``mechanism``. Once the file is structurally valid,
+:func:`cadgen.feasibility.design_problems` adds the problems that need the kinematic
+model; it is imported inside the call, so parsing alone (and ``cadgen --help``) does
+not pay for numpy and scipy. Validation never writes anything.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Annotated, Any, Union, get_args
+
+from pydantic import Field, TypeAdapter, ValidationError
+
+from kinematics.errors import DesignError, Problem
+
+from ._problems import _describe, _problems_from_error, _union_members
+from .planting import PlantingParameters
+from .pricking import PrickingParameters
+
+__all__ = [
+    "ParameterError",
+    "DesignParameters",
+    "MECHANISM_KINDS",
+    "load_params",
+    "validate_text",
+    "validate_data",
+]
+
+
+class ParameterError(DesignError):
+    """A parameter file with problems; ``problems`` lists all of them.
+
+    Also a :class:`ValueError` (through :class:`~kinematics.errors.DesignError`).
+    """
+
+
+DesignParameters = Annotated[
+    Union[PlantingParameters, PrickingParameters], Field(discriminator="mechanism")
+]
+"""Every mechanism kind, told apart by ``mechanism``."""
+
+_DESIGN_ADAPTER = TypeAdapter(DesignParameters)
+
+_ROOT_NODE = ("union", "mechanism", _union_members(get_args(DesignParameters)[0], "mechanism"))
+MECHANISM_KINDS = tuple(_ROOT_NODE[2])
+"""Known mechanism kinds."""
+
+
+# --------------------------------------------------------------------------- entry points
+
+
+def _structural(data: Mapping[str, Any]) -> tuple[Any, list[Problem]]:
+    try:
+        return _DESIGN_ADAPTER.validate_python(data), []
+    except ValidationError as exc:
+        problems: list[Problem] = []
+        for error in exc.errors(include_url=False):
+            problems += _problems_from_error(error, _ROOT_NODE)
+        return None, problems
+
+
+def _feasibility_problems(params: Any) -> list[Problem]:
+    # Imported here: the kinematic checks pull in numpy/scipy, which a caller that
+    # only parses (or prints --help) should not pay for.
+    from cadgen.feasibility import design_problems
+
+    try:
+        return list(design_problems(params))
+    except DesignError as exc:
+        return list(exc.problems)
+
+
+def validate_data(
+    data: Mapping[str, Any], source: str | None = None, *, check_feasibility: bool = True
+) -> PlantingParameters | PrickingParameters:
+    """Validate an already-parsed parameter mapping.
+
+    Parameters
+    ----------
+    data : mapping
+        The parsed file (what :func:`tomllib.loads` returns).
+    source : str, optional
+        Where the data came from, for the error message.
+    check_feasibility : bool, default True
+        Also run :func:`cadgen.feasibility.design_problems` once the structure is
+        valid (it needs the kinematic model).
+
+    Returns
+    -------
+    PlantingParameters or PrickingParameters
+        The validated, frozen parameters (the member of :data:`DesignParameters`
+        that ``mechanism`` names).
+
+    Raises
+    ------
+    ParameterError
+        Listing every problem found.
+    """
+    if not isinstance(data, Mapping):
+        problem = Problem("", "wrong_type", f"expected a table, not {_describe(data)}")
+        raise ParameterError([problem], source)
+    params, problems = _structural(data)
+    if not problems and check_feasibility:
+        problems = _feasibility_problems(params)
+    if problems:
+        raise ParameterError(problems, source)
+    return params
+
+
+_TOML_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+
+
+def _syntax_problem(exc: tomllib.TOMLDecodeError) -> Problem:
+    text = str(exc)
+    match = _TOML_POSITION.search(text)
+    line = getattr(exc, "lineno", None) or (int(match.group(1)) if match else None)
+    column = getattr(exc, "colno", None) or (int(match.group(2)) if match else None)
+    reason = getattr(exc, "msg", None) or (_TOML_POSITION.sub("", text) if match else text)
+    where = f" at line {line}, column {column}" if line is not None else ""
+    return Problem("", "toml_syntax", f"TOML syntax error{where}: {reason}")
+
+
+def validate_text(
+    text: str, source: str | None = None, *, check_feasibility: bool = True
+) -> PlantingParameters | PrickingParameters:
+    """Parse and validate the text of a parameter file.
+
+    Parameters
+    ----------
+    text : str
+        TOML text.
+    source : str, optional
+        Where the text came from (a file name), for the error message.
+    check_feasibility : bool, default True
+        See :func:`validate_data`.
+
+    Returns
+    -------
+    PlantingParameters or PrickingParameters
+        The validated, frozen parameters.
+
+    Raises
+    ------
+    ParameterError
+        Listing every problem; a TOML syntax error is a single ``toml_syntax``
+        problem with its line and column.
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError([_syntax_problem(exc)], source) from None
+    return validate_data(data, source, check_feasibility=check_feasibility)
+
+
+def load_params(
+    path: str | Path, *, check_feasibility: bool = True
+) -> PlantingParameters | PrickingParameters:
+    """Read, parse and validate a parameter file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A UTF-8 TOML file (a leading byte-order mark is tolerated).
+    check_feasibility : bool, default True
+        See :func:`validate_data`.
+
+    Returns
+    -------
+    PlantingParameters or PrickingParameters
+        The validated, frozen parameters.
+
+    Raises
+    ------
+    ParameterError
+        Listing every problem, including a missing, unreadable or non-UTF-8 file.
+    """
+    path = Path(path)
+    source = str(path)
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        problem = Problem("", "file_not_found", f"no such file: {source}")
+        raise ParameterError([problem], source) from None
+    except IsADirectoryError:
+        raise ParameterError([Problem("", "not_readable", f"{source} is a directory, not a file")],
+                             source) from None
+    except OSError as exc:
+        raise ParameterError([Problem("", "not_readable", f"cannot read {source}: {exc.strerror}")],
+                             source) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ParameterError(
+            [Problem("", "not_utf8",
+                     f"the file is not UTF-8 text: byte 0x{raw[exc.start]:02x} at offset "
+                     f"{exc.start} (line {line}); save it as UTF-8")],
+            source,
+        ) from None
+    return validate_text(text.removeprefix("\ufeff"), source, check_feasibility=check_feasibility)
