@@ -362,7 +362,17 @@ def test_validate_data_rejects_a_non_mapping():
 # --------------------------------------------------------------------------- feasibility hook
 
 
-def test_feasibility_problems_join_the_parameter_error(monkeypatch):
+# (file, model it validates to, a structurally invalid file of the same kind)
+HOOK_CASES = {
+    "planting": (REFERENCE, "PlantingParameters", INVALID / "bad_e2.toml"),
+    "pricking": (ROOT / "params" / "kernel-a.toml", "PrickingParameters",
+                 INVALID / "pricking" / "pricking_degree_4.toml"),
+}
+
+
+@pytest.mark.parametrize("kind", HOOK_CASES)
+def test_feasibility_problems_join_the_parameter_error(kind, monkeypatch):
+    path, model, _ = HOOK_CASES[kind]
     seen = []
 
     def fake(params):
@@ -370,26 +380,29 @@ def test_feasibility_problems_join_the_parameter_error(monkeypatch):
         return [Problem("pitch_curve.b1", "pointed_pitch_curve", "r1 touches zero")]
 
     monkeypatch.setattr(cadgen.feasibility, "design_problems", fake)
-    problems = _problems(REFERENCE)
+    problems = _problems(path)
     assert [(p.path, p.code) for p in problems] == [("pitch_curve.b1", "pointed_pitch_curve")]
-    assert len(seen) == 1 and isinstance(seen[0], PlantingParameters)
+    assert len(seen) == 1 and type(seen[0]).__name__ == model
 
 
-def test_feasibility_design_error_is_folded_in(monkeypatch):
+@pytest.mark.parametrize("kind", HOOK_CASES)
+def test_feasibility_design_error_is_folded_in(kind, monkeypatch):
     def fake(params):
         raise DesignError([Problem("train.R", "tiny_intermediate_radius", "a - r1 is tiny")])
 
     monkeypatch.setattr(cadgen.feasibility, "design_problems", fake)
-    assert [p.code for p in _problems(REFERENCE)] == ["tiny_intermediate_radius"]
+    assert [p.code for p in _problems(HOOK_CASES[kind][0])] == ["tiny_intermediate_radius"]
 
 
-def test_feasibility_is_skipped_when_the_structure_is_wrong_or_when_asked(monkeypatch):
+@pytest.mark.parametrize("kind", HOOK_CASES)
+def test_feasibility_is_skipped_when_the_structure_is_wrong_or_when_asked(kind, monkeypatch):
+    path, _, invalid = HOOK_CASES[kind]
     calls = []
     monkeypatch.setattr(
         cadgen.feasibility, "design_problems", lambda params: calls.append(params) or []
     )
-    _problems(INVALID / "bad_e2.toml")
-    load_params(REFERENCE, check_feasibility=False)
+    _problems(invalid)
+    load_params(path, check_feasibility=False)
     assert calls == []
-    load_params(REFERENCE)
+    load_params(path)
     assert len(calls) == 1

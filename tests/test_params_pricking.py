@@ -15,7 +15,6 @@ from pathlib import Path
 import pydantic
 import pytest
 
-import cadgen.feasibility
 from cadgen.params import (
     EQUAL_PERIMETER,
     MECHANISM_KINDS,
@@ -30,7 +29,7 @@ from cadgen.params import (
     validate_data,
     validate_text,
 )
-from kinematics.errors import DesignError, Problem
+from kinematics.errors import Problem
 
 ROOT = Path(__file__).resolve().parents[1]
 KERNEL_A = ROOT / "params" / "kernel-a.toml"
@@ -523,37 +522,4 @@ def test_validate_data_returns_pricking_parameters():
     assert params.trajectory.points[4] == (0.5, 0.5)
 
 
-# --------------------------------------------------------------------------- feasibility hook
-
-
-def test_feasibility_is_called_with_pricking_parameters(monkeypatch):
-    seen = []
-
-    def fake(params):
-        seen.append(params)
-        return [Problem("trajectory.points", "sun_inside_loop", "O is inside the loop")]
-
-    monkeypatch.setattr(cadgen.feasibility, "design_problems", fake)
-    problems = _problems(KERNEL_A)
-    assert [(p.path, p.code) for p in problems] == [("trajectory.points", "sun_inside_loop")]
-    assert len(seen) == 1 and isinstance(seen[0], PrickingParameters)
-
-
-def test_feasibility_design_error_is_folded_in(monkeypatch):
-    def fake(params):
-        raise DesignError([Problem("gears.min_ratio", "ratio_too_small", "i falls to 0.01")])
-
-    monkeypatch.setattr(cadgen.feasibility, "design_problems", fake)
-    assert [p.code for p in _problems(KERNEL_B)] == ["ratio_too_small"]
-
-
-def test_feasibility_is_skipped_when_the_structure_is_wrong_or_when_asked(monkeypatch):
-    calls = []
-    monkeypatch.setattr(
-        cadgen.feasibility, "design_problems", lambda params: calls.append(params) or []
-    )
-    _problems(INVALID / "pricking_degree_4.toml")
-    load_params(KERNEL_A, check_feasibility=False)
-    assert calls == []
-    load_params(KERNEL_A)
-    assert len(calls) == 1
+# The feasibility hook is tested for both mechanism kinds in tests/test_params.py.
