@@ -1,0 +1,404 @@
+"""DXF export: round trip through ezdxf, the chord-tolerance guarantee, atomicity, bad input, train sheet."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+ezdxf = pytest.importorskip("ezdxf")
+shapely = pytest.importorskip("shapely")
+
+import cadgen.atomic
+import cadgen.export_dxf as export_dxf
+from cadgen.export_dxf import DxfExportError, DxfInputError, DxfSummary, write_gear_dxf, write_train_sheet
+from cadgen.gear_profile import GearProfile
+from kinematics.errors import MechanismError
+
+ACCURACY = 1e-9  # mm: float slack on the chord-tolerance guarantee (coordinates round-trip exactly)
+
+
+# --------------------------------------------------------------------------- test profiles
+
+
+def _densify(vertices, step=0.01):
+    """Points every ``step`` mm along the open polyline ``vertices`` (its last vertex left out)."""
+    vertices = np.asarray(vertices, dtype=float)
+    pieces = []
+    for start, end in zip(vertices[:-1], vertices[1:]):
+        count = max(1, math.ceil(np.linalg.norm(end - start) / step))
+        pieces.append(start + (end - start) * (np.arange(count) / count)[:, None])
+    return np.vstack(pieces)
+
+
+def star_profile(samples=20000):
+    """Gear-like star r(t) = 30 + 2 sin(24 t), CCW; pitch circle r = 30 (24 teeth of module 2.5), bore 5."""
+    t = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
+    radius = 30.0 + 2.0 * np.sin(24.0 * t)
+    outline = np.column_stack([radius * np.cos(t), radius * np.sin(t)])
+    s = np.linspace(0.0, 2.0 * np.pi, 2000, endpoint=False)
+    pitch = np.column_stack([30.0 * np.cos(s), 30.0 * np.sin(s)])
+    return GearProfile("star gear", outline, pitch, teeth=24, module=2.5, bore_radius=5.0)
+
+
+def bay_profile():
+    """Disc r = 30 with a deep concave bay: a slot 20 mm deep, 1.8 mm wide, a spike from its lower
+    wall reaching into a notch of its upper wall (0.2 mm gap). Plain Douglas-Peucker at 0.5 mm drops
+    the notch and its upper wall then crosses the spike: the retry-with-halved-tolerance case."""
+    lower, upper = -1.0, 0.8
+    x_lower, x_upper = math.sqrt(30.0**2 - lower**2), math.sqrt(30.0**2 - upper**2)
+    t = np.linspace(math.atan2(upper, x_upper), 2.0 * np.pi + math.atan2(lower, x_lower), 6000, endpoint=False)
+    rim = np.column_stack([30.0 * np.cos(t), 30.0 * np.sin(t)])
+    bay = _densify([(x_lower, lower), (20.2, lower), (20.0, 1.0), (19.8, lower), (10.0, lower),
+                    (10.0, upper), (19.0, upper), (19.0, 1.2), (21.0, 1.2), (21.0, upper), (x_upper, upper)])
+    outline = np.vstack([rim, bay])
+    s = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
+    pitch = np.column_stack([28.0 * np.cos(s), 28.0 * np.sin(s)])
+    return GearProfile("bay part", outline, pitch, teeth=20, module=2.8, bore_radius=5.0)
+
+
+PROFILES = {"star": star_profile, "bay": bay_profile}
+
+
+@pytest.fixture(scope="module")
+def star():
+    return star_profile()
+
+
+@pytest.fixture(scope="module")
+def bay():
+    return bay_profile()
+
+
+def _profile(name, star, bay):
+    return {"star": star, "bay": bay}[name]
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _entities(doc, layer, kind):
+    return [e for e in doc.modelspace() if e.dxf.layer == layer and e.dxftype() == kind]
+
+
+def _xy(vector):
+    return np.array([vector.x, vector.y])
+
+
+def _written_outline(path):
+    doc = ezdxf.readfile(path)
+    (polyline,) = _entities(doc, "OUTLINE", "LWPOLYLINE")
+    return np.array(polyline.get_points(format="xy"), dtype=float)
+
+
+def _area_perimeter(points):
+    ring = shapely.LinearRing(points)
+    return shapely.Polygon(ring).area, ring.length
+
+
+# --------------------------------------------------------------------------- round trip
+
+
+@pytest.mark.parametrize("name", ["star", "bay"], ids=["star", "bay"])
+def test_round_trip_layers_entities_units(tmp_path, name, star, bay):
+    profile = _profile(name, star, bay)
+    path = tmp_path / f"{profile.file_stem}.dxf"
+    summary = write_gear_dxf(path, profile, chord_tolerance=0.005)
+    assert isinstance(summary, DxfSummary) and summary.path == path
+    assert sorted(os.listdir(tmp_path)) == [path.name]  # no temporary file left behind
+
+    doc = ezdxf.readfile(path)
+    auditor = doc.audit()
+    assert not auditor.has_errors and not auditor.has_fixes
+    assert doc.units == ezdxf.units.MM
+    assert doc.header["$INSUNITS"] == ezdxf.units.MM and doc.header["$MEASUREMENT"] == 1
+    for layer, colour in export_dxf.LAYERS.items():
+        assert doc.layers.get(layer).dxf.color == colour
+
+    (outline,) = _entities(doc, "OUTLINE", "LWPOLYLINE")
+    (pitch,) = _entities(doc, "PITCH", "LWPOLYLINE")
+    assert outline.closed and pitch.closed
+    points = np.array(outline.get_points(format="xy"))
+    assert len(points) == summary.outline_points_written
+    assert not np.array_equal(points[0], points[-1])  # closed by the flag, not by a repeated point
+    ring = shapely.LinearRing(points)
+    assert ring.is_simple and ring.is_ccw
+    assert summary.outline_area == pytest.approx(shapely.Polygon(ring).area, rel=1e-12)
+    assert summary.outline_perimeter == pytest.approx(ring.length, rel=1e-12)
+
+    (bore,) = _entities(doc, "BORE", "CIRCLE")
+    assert bore.dxf.radius == pytest.approx(profile.bore_radius)
+    assert np.allclose(_xy(bore.dxf.center), profile.centre)
+
+    lines = _entities(doc, "CENTRE", "LINE")
+    assert len(lines) == 2
+    directions = []
+    for line in lines:
+        start, end = _xy(line.dxf.start), _xy(line.dxf.end)
+        assert np.linalg.norm(end - start) == pytest.approx(2.0 * profile.module)
+        assert np.allclose((start + end) / 2.0, profile.centre)  # crossing at the centre
+        directions.append((end - start) / np.linalg.norm(end - start))
+    assert abs(np.dot(*directions)) < 1e-12  # perpendicular
+    # Nothing else in the drawing.
+    assert len(doc.modelspace()) == 5
+
+
+def test_no_bore_no_circle(tmp_path, star):
+    profile = GearProfile("solid", star.outline, star.pitch_curve, teeth=24, module=2.5, bore_radius=0.0)
+    write_gear_dxf(tmp_path / "solid.dxf", profile)
+    doc = ezdxf.readfile(tmp_path / "solid.dxf")
+    assert _entities(doc, "BORE", "CIRCLE") == []
+    assert len(_entities(doc, "OUTLINE", "LWPOLYLINE")) == 1
+
+
+def test_same_input_same_bytes(tmp_path, star):
+    first = write_gear_dxf(tmp_path / "a.dxf", star).path.read_bytes()
+    second = write_gear_dxf(tmp_path / "b.dxf", star).path.read_bytes()
+    assert first == second
+    assert ezdxf.options.write_fixed_meta_data_for_testing is False  # the global switch is restored
+
+
+def test_clockwise_input_written_counter_clockwise(tmp_path, star):
+    reversed_star = GearProfile("cw", star.outline[::-1], star.pitch_curve[::-1], teeth=24, module=2.5,
+                                bore_radius=5.0)
+    summary = write_gear_dxf(tmp_path / "cw.dxf", reversed_star)
+    assert shapely.LinearRing(_written_outline(tmp_path / "cw.dxf")).is_ccw
+    reference = write_gear_dxf(tmp_path / "ccw.dxf", star)
+    assert summary.outline_area == pytest.approx(reference.outline_area, rel=1e-5)
+
+
+# --------------------------------------------------------------------------- chord tolerance
+
+
+@pytest.mark.parametrize("tolerance", [0.001, 0.005, 0.05], ids=["1um", "5um", "50um"])
+@pytest.mark.parametrize("name", ["star", "bay"], ids=["star", "bay"])
+def test_chord_tolerance_guarantee(tmp_path, name, tolerance, star, bay):
+    profile = _profile(name, star, bay)
+    summary = write_gear_dxf(tmp_path / "gear.dxf", profile, chord_tolerance=tolerance)
+    assert summary.chord_tolerance_used == tolerance
+    written = _written_outline(tmp_path / "gear.dxf")
+    dense = np.asarray(profile.outline)
+    assert len(written) < len(dense)
+
+    # The guarantee: every dense point within the tolerance of the written polyline.
+    distances = shapely.distance(shapely.points(dense), shapely.LinearRing(written))
+    assert distances.max() <= tolerance + ACCURACY
+
+    written_area, written_perimeter = _area_perimeter(written)
+    dense_area, dense_perimeter = _area_perimeter(dense)
+    chords = np.linalg.norm(np.roll(written, -1, axis=0) - written, axis=1)
+    # Area bound. Each written chord (length L) replaces a run of dense points lying within
+    # `tolerance` of it, so the region between run and chord lies in the half-capsules of
+    # width `tolerance` about the chord: |area change| <= tolerance * L + pi tolerance^2 / 2.
+    # Summed: |dA| <= tolerance * P_written + n pi tolerance^2 / 2.
+    area_bound = tolerance * written_perimeter + len(written) * math.pi * tolerance**2 / 2.0
+    assert abs(written_area - dense_area) <= area_bound
+    # Perimeter bound. A chord is never longer than the run it replaces (so P_written <= P_dense),
+    # and a smooth run bulging at most h = tolerance from a chord of length L is longer by about
+    # 8 h^2 / (3 L) (a single arc), at most pi^2 h^2 / L (a full sine wave, an S across the chord);
+    # a corner dropped inside the band adds 2 h^2 / L. The brief's "relative 1e-4" does not hold
+    # here: the star's tips have a 0.87 mm radius of curvature, so at 5 um it is ~2e-4.
+    perimeter_bound = float(np.sum(math.pi**2 * tolerance**2 / chords))
+    assert 0.0 <= dense_perimeter - written_perimeter <= perimeter_bound
+    # And the returned measures describe the written outline.
+    assert summary.outline_area == pytest.approx(written_area, rel=1e-12)
+    assert summary.outline_perimeter == pytest.approx(written_perimeter, rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["star", "bay"], ids=["star", "bay"])
+def test_coarser_tolerance_fewer_points_and_simple(tmp_path, name, star, bay):
+    profile = _profile(name, star, bay)
+    counts = []
+    for index, tolerance in enumerate([0.0005, 0.001, 0.005, 0.02, 0.1, 0.5, 2.0]):
+        path = tmp_path / f"gear-{index}.dxf"
+        summary = write_gear_dxf(path, profile, chord_tolerance=tolerance)
+        written = _written_outline(path)
+        assert len(written) == summary.outline_points_written
+        assert shapely.LinearRing(written).is_simple
+        counts.append(summary.outline_points_written)
+    assert all(fine >= coarse for fine, coarse in zip(counts, counts[1:])), counts
+    assert counts[0] > counts[-1]
+
+
+def test_tolerance_halved_when_thinning_breaks_simplicity(tmp_path, bay, monkeypatch):
+    # The topology-preserving simplifier keeps the bay simple at 0.5 mm ...
+    assert write_gear_dxf(tmp_path / "topo.dxf", bay, chord_tolerance=0.5).chord_tolerance_used == 0.5
+    # ... plain Douglas-Peucker does not: its upper wall cuts through the spike. The writer must
+    # notice, halve the tolerance, and report the one it used.
+    plain = shapely.LinearRing(bay.outline).simplify(0.5, preserve_topology=False)
+    assert not plain.is_simple
+    monkeypatch.setattr(export_dxf, "_douglas_peucker",
+                        lambda ring, tolerance: ring.simplify(tolerance, preserve_topology=False))
+    summary = write_gear_dxf(tmp_path / "plain.dxf", bay, chord_tolerance=0.5)
+    assert summary.chord_tolerance_used == 0.25
+    written = _written_outline(tmp_path / "plain.dxf")
+    assert shapely.LinearRing(written).is_simple
+    distances = shapely.distance(shapely.points(bay.outline), shapely.LinearRing(written))
+    assert distances.max() <= summary.chord_tolerance_used + ACCURACY
+
+
+# --------------------------------------------------------------------------- atomicity
+
+
+def _fail_rename(*args, **kwargs):
+    raise OSError("simulated failure while renaming the temporary file into place")
+
+
+@pytest.mark.parametrize("existing", [False, True], ids=["new-file", "existing-file"])
+def test_failed_rename_leaves_nothing(tmp_path, star, monkeypatch, existing):
+    target = tmp_path / "gear.dxf"
+    if existing:
+        target.write_bytes(b"previous contents")
+    # The temporary file is fully written, then the rename fails.
+    monkeypatch.setattr(cadgen.atomic.os, "replace", _fail_rename)
+    with pytest.raises(OSError, match="simulated failure"):
+        write_gear_dxf(target, star)
+    monkeypatch.undo()
+    assert sorted(os.listdir(tmp_path)) == (["gear.dxf"] if existing else [])
+    if existing:
+        assert target.read_bytes() == b"previous contents"
+
+
+@pytest.mark.parametrize("existing", [False, True], ids=["new-file", "existing-file"])
+def test_failed_audit_writes_nothing(tmp_path, star, monkeypatch, existing):
+    target = tmp_path / "gear.dxf"
+    if existing:
+        target.write_bytes(b"previous contents")
+    add_gear = export_dxf._add_gear
+
+    def add_gear_and_a_bad_line(msp, *args, **kwargs):
+        add_gear(msp, *args, **kwargs)
+        msp.add_line((0, 0), (1, 1), dxfattribs={"layer": "OUTLINE", "linetype": "NO_SUCH_LINETYPE"})
+
+    monkeypatch.setattr(export_dxf, "_add_gear", add_gear_and_a_bad_line)
+    with pytest.raises(DxfExportError, match="(?i)audit") as caught:
+        write_gear_dxf(target, star)
+    assert isinstance(caught.value, MechanismError) and not isinstance(caught.value, ValueError)
+    assert any("linetype" in problem.lower() for problem in caught.value.problems)
+    assert sorted(os.listdir(tmp_path)) == (["gear.dxf"] if existing else [])
+    if existing:
+        assert target.read_bytes() == b"previous contents"
+
+
+# --------------------------------------------------------------------------- bad input
+
+
+def _with(profile, **changes):
+    fields = dict(name=profile.name, outline=profile.outline, pitch_curve=profile.pitch_curve,
+                  teeth=profile.teeth, module=profile.module, bore_radius=profile.bore_radius)
+    fields.update(changes)
+    return GearProfile(**fields)
+
+
+BOW_TIE = np.array([[0.0, 0.0], [10.0, 10.0], [10.0, 0.0], [0.0, 10.0]])
+
+
+def _nan_outline(profile):
+    outline = np.array(profile.outline, dtype=float)
+    outline[7] = [np.nan, 3.0]
+    return outline
+
+
+BAD_PROFILES = [
+    ("bow-tie", lambda p: _with(p, outline=BOW_TIE, bore_radius=0.0), r"outline is self-intersecting.*5 5"),
+    ("nan-point", lambda p: _with(p, outline=_nan_outline(p)), r"outline has 1 non-finite point.*index 7.*nan"),
+    ("two-points", lambda p: _with(p, outline=np.array([[0.0, 0.0], [1.0, 0.0]])), r"at least 3 distinct points, got 2"),
+    ("flat-array", lambda p: _with(p, outline=np.zeros(6)), r"\(n, 2\) array of points, got shape \(6,\)"),
+    ("pitch-nan", lambda p: _with(p, pitch_curve=np.full((5, 2), np.nan)), r"pitch_curve has 5 non-finite"),
+    ("module-zero", lambda p: _with(p, module=0.0), r"module must be a finite number > 0, got 0.0"),
+    ("bore-negative", lambda p: _with(p, bore_radius=-1.0), r"bore_radius must be .* >= 0, got -1.0"),
+    ("bore-too-big", lambda p: _with(p, bore_radius=29.0), r"bore \(radius 29.0 mm.*not inside the outline"),
+]
+
+
+@pytest.mark.parametrize("make, pattern", [case[1:] for case in BAD_PROFILES], ids=[case[0] for case in BAD_PROFILES])
+def test_bad_profile_raises_value_error(tmp_path, star, make, pattern):
+    with pytest.raises(ValueError, match=pattern) as caught:
+        write_gear_dxf(tmp_path / "bad.dxf", make(star))
+    assert isinstance(caught.value, DxfInputError) and isinstance(caught.value, MechanismError)
+    assert os.listdir(tmp_path) == []
+
+
+def test_every_problem_reported_together(tmp_path, star):
+    bad = _with(star, outline=BOW_TIE, module=math.inf, bore_radius=math.nan)
+    with pytest.raises(DxfInputError) as caught:
+        write_gear_dxf(tmp_path / "bad.dxf", bad)
+    text = "\n".join(caught.value.problems)
+    assert len(caught.value.problems) == 3
+    assert "self-intersecting" in text and "module" in text and "bore_radius" in text
+
+
+@pytest.mark.parametrize("tolerance", [0.0, -0.01, math.nan, math.inf, "fine"], ids=["zero", "negative", "nan", "inf", "text"])
+def test_bad_tolerance_raises_value_error(tmp_path, star, tolerance):
+    with pytest.raises(ValueError, match=rf"chord_tolerance must be a finite number > 0 mm, got {tolerance!r}"):
+        write_gear_dxf(tmp_path / "bad.dxf", star, chord_tolerance=tolerance)
+    with pytest.raises(ValueError, match="chord_tolerance"):
+        write_train_sheet(tmp_path / "bad.dxf", [(star, 0.0, (0.0, 0.0))], chord_tolerance=tolerance)
+    assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- train sheet
+
+
+def test_train_sheet_two_gears(tmp_path, star, bay):
+    placements = [(star, 0.3, (-40.0, 0.0)), (bay, -1.1, (45.0, 10.0))]
+    path = tmp_path / "train.dxf"
+    summaries = write_train_sheet(path, placements, chord_tolerance=0.005)
+    assert len(summaries) == 2 and all(s.path == path for s in summaries)
+    assert sorted(os.listdir(tmp_path)) == ["train.dxf"]
+
+    doc = ezdxf.readfile(path)
+    assert not doc.audit().has_errors
+    assert doc.units == ezdxf.units.MM
+    outlines = _entities(doc, "OUTLINE", "LWPOLYLINE")
+    pitches = _entities(doc, "PITCH", "LWPOLYLINE")
+    labels = _entities(doc, "LABELS", "TEXT")
+    assert len(outlines) == 2 and len(pitches) == 2 and len(labels) == 2
+    assert len(_entities(doc, "BORE", "CIRCLE")) == 2 and len(_entities(doc, "CENTRE", "LINE")) == 4
+    assert all(polyline.closed for polyline in outlines + pitches)
+    assert [label.dxf.text for label in labels] == ["star gear", "bay part"]
+
+    for (profile, angle, offset), polyline, label, summary in zip(placements, outlines, labels, summaries):
+        written = np.array(polyline.get_points(format="xy"))
+        assert len(written) == summary.outline_points_written
+        centroid = np.array(shapely.Polygon(written).centroid.coords[0])
+        dense_placed, _ = profile.placed(angle, offset)
+        expected = np.array(shapely.Polygon(dense_placed).centroid.coords[0])
+        # Thinning moves the boundary by at most the tolerance: the centroid moves far less than 0.01 mm.
+        assert np.linalg.norm(centroid - expected) < 0.01
+        if profile is star:  # 24-fold symmetric: its centroid is its centre, i.e. the offset
+            assert np.allclose(centroid, offset, atol=1e-3)
+        # The pose is the one asked for: every dense placed point within the tolerance of the written one.
+        distances = shapely.distance(shapely.points(dense_placed), shapely.LinearRing(written))
+        assert distances.max() <= summary.chord_tolerance_used + ACCURACY
+        # Label centred under its gear.
+        anchor = _xy(label.dxf.align_point)
+        assert anchor[0] == pytest.approx(offset[0])
+        assert anchor[1] < written[:, 1].min()
+
+
+def test_train_sheet_bad_placements(tmp_path, star):
+    with pytest.raises(ValueError, match="placements is empty"):
+        write_train_sheet(tmp_path / "t.dxf", [])
+    bad = [(star, math.nan, (0.0, 0.0)), (star, 0.0, (1.0, math.inf)), (star, 0.0)]
+    with pytest.raises(DxfInputError) as caught:
+        write_train_sheet(tmp_path / "t.dxf", bad)
+    text = "\n".join(caught.value.problems)
+    assert "placements[0]" in text and "angle" in text and "nan" in text
+    assert "placements[1]" in text and "offset" in text and "inf" in text
+    assert "placements[2]" in text
+    assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- import weight
+
+
+def test_import_does_not_load_engines():
+    code = ("import sys, cadgen.export_dxf; "
+            "loaded = [m for m in ('ezdxf', 'shapely') if m in sys.modules]; "
+            "assert not loaded, loaded")
+    subprocess.run([sys.executable, "-c", code], check=True)
