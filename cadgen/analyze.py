@@ -31,6 +31,8 @@ class AnalysisResult:
             text = pricking_summary(self.report)
         else:
             text = format_metrics_table(self.report)
+        if "gear_train" in self.report:
+            text += "\n\n" + format_gear_table(self.report["gear_train"])
         return text + (
             f"\nwrote {len(self.files)} files to {self.output_dir}" if self.output_dir else "")
 
@@ -158,18 +160,48 @@ def format_metrics_table(report: dict) -> str:
     return "\n".join(lines)
 
 
+def format_gear_table(gear_train: dict) -> str:
+    """Plain-text table of the generated gears and their meshes."""
+    rows = [("gear", "teeth", "module", "cutter", "undercut teeth", "pointed", "problems")]
+    for g in gear_train["gears"]:
+        rows.append((g["gear"], str(g["teeth"]), f"{g['module_mm']:.4f}", g["cutter"] +
+                     (f" (z={g['shaper_teeth']})" if g["shaper_teeth"] else ""),
+                     str(len(g["undercut_teeth"])), str(len(g["pointed_teeth"])),
+                     ", ".join(p["code"] for p in g["problems"]) or "-"))
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in rows]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    lines.append("")
+    for m in gear_train["meshes"]:
+        relief = m["tip_relief"]
+        lines.append(
+            f"mesh {m['stage']}: {m['interference_poses']} interfering poses of {m['poses']} "
+            f"(largest overlap {m['overlap_area_max_mm2']:.1e} mm2), backlash "
+            f"{m['backlash_deg'][0]:.1e}..{m['backlash_deg'][1]:.1e} deg, transmission error "
+            f"{m['transmission_error_pp_deg']:.1e} deg p-p"
+            + (f"; tip relief on the {relief['gear']} gear: {relief['removed_area_mm2']:.3f} mm2, "
+               f"up to {relief['depth_mm']:.3f} mm deep" if relief else ""))
+    for f in gear_train["failures"]:
+        lines.append(f"NOT CUT [{f['code']}] {f['message']}")
+    return "\n".join(lines)
+
+
 def run_analysis(params, output_root: Path | str | None = Path("outputs"),
-                 steps_per_revolution: int | None = None, plots: bool = True) -> AnalysisResult:
+                 steps_per_revolution: int | None = None, plots: bool = True,
+                 gears: bool = True) -> AnalysisResult:
     """Analyse one validated design; write ``<output_root>/<name>/`` atomically.
 
     With ``output_root=None`` nothing is written (the report is still returned).
+    ``gears`` generates, checks and meshes every gear of the trains and writes
+    their DXF files under ``gears/``.
     """
+    draw = plots and output_root is not None
     if params.mechanism == "pricking":
-        report, figures = _pricking(params, plots and output_root is not None)
+        report, figures = _pricking(params, draw, gears)
     else:
-        report, figures = _planting(params, steps_per_revolution,
-                                    plots and output_root is not None)
+        report, figures = _planting(params, steps_per_revolution, draw, gears)
     if output_root is None:
+        report.pop("_train", None)
         return AnalysisResult(params.name, report, None)
     from .atomic import staged_directory
 
@@ -177,6 +209,14 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
     files = []
     with staged_directory(final) as staging:
         (staging / "plots").mkdir()
+        train = report.pop("_train", None)
+        if train is not None and train.stages:
+            from .gear_trains import write_train_files
+
+            (staging / "gears").mkdir()
+            for path in write_train_files(train, staging / "gears",
+                                          params.gears.chord_tolerance):
+                files.append(f"gears/{Path(path).name}")
         for name, data in figures.items():
             (staging / "plots" / name).write_bytes(data)
             files.append(f"plots/{name}")
@@ -185,7 +225,7 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
     return AnalysisResult(params.name, report, final, sorted(files))
 
 
-def _planting(params, steps_per_revolution, plots):
+def _planting(params, steps_per_revolution, plots, gears=True):
     from .design import build_mechanism, evaluate
 
     timings: dict = {}
@@ -194,16 +234,23 @@ def _planting(params, steps_per_revolution, plots):
         mechanism.closure  # solve the closure inside its own stage
     with _stage(timings, "metrics"):
         evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
+    train = None
+    if gears:
+        with _stage(timings, "gears"):
+            from .gear_trains import planting_train
+
+            train = planting_train(params, mechanism)
     figures = {}
     if plots:
         with _stage(timings, "plots"):
             from .plots import planting_figures
 
             figures = planting_figures(mechanism, evaluation)
-    return report_dict(params, mechanism, evaluation, timings), figures
+            figures.update(_gear_figures(train))
+    return _with_train(report_dict(params, mechanism, evaluation, timings), train), figures
 
 
-def _pricking(params, plots):
+def _pricking(params, plots, gears=True):
     from .design import pricking_design, pricking_field
     from .pricking_report import pricking_report
 
@@ -212,14 +259,39 @@ def _pricking(params, plots):
         design = pricking_design(params)
     with _stage(timings, "field"):
         field = pricking_field(params, design)
+    train = None
+    if gears:
+        with _stage(timings, "gears"):
+            from .gear_trains import pricking_train
+
+            train = pricking_train(params, design)
     figures = {}
     if plots:
         with _stage(timings, "plots"):
             from .plots_pricking import pricking_figures
 
             figures = pricking_figures(params, design, field)
+            figures.update(_gear_figures(train))
     report = pricking_report(params, design, field, timings, _versions(), input_hash(params))
-    return report, figures
+    return _with_train(report, train), figures
+
+
+def _gear_figures(train):
+    if train is None or not train.stages:
+        return {}
+    from .gear_trains import pair_figures
+
+    return pair_figures(train)
+
+
+def _with_train(report, train):
+    """Add the gear table to the report; keep the train itself for the file writer."""
+    if train is not None:
+        from .gear_trains import train_report
+
+        report["gear_train"] = train_report(train)
+        report["_train"] = train
+    return report
 
 
 def _jsonable(value):

@@ -16,12 +16,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+import shapely.errors
+
 from kinematics.arclength import ArcLengthCurve
+from kinematics.errors import DesignError
 
 from .gear_profile import GearProfile
 from .teeth import CutterChoice, ToothSystem, gear_outline
 
-__all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "MIN_SHAPER_TEETH"]
+__all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "generate_gear",
+           "mating_phase", "circle_pair", "MIN_SHAPER_TEETH"]
 
 #: The smallest pinion cutter considered (fewer teeth would undercut itself).
 MIN_SHAPER_TEETH = 10
@@ -46,6 +50,7 @@ class PitchPair:
     drive: object
     driven: object
     breaks: tuple = ()
+    curve_periods: tuple = ()   # tau range in which each gear turns once (default: period)
 
     def rotations(self, tau):
         """Body rotations (drive, driven) in rad that put the contact on the x axis."""
@@ -65,9 +70,27 @@ class PitchPair:
             perp = np.stack([-u[..., 1], u[..., 0]], axis=-1)
             return drho[..., None] * u + (rho * dpsi)[..., None] * perp
 
+        period = self.curve_periods[which] if self.curve_periods else self.period
         breaks = np.asarray(self.breaks) if len(self.breaks) else None
-        return ArcLengthCurve.from_parametric(position, velocity, self.period, breaks=breaks,
+        return ArcLengthCurve.from_parametric(position, velocity, period, breaks=breaks,
                                               samples=samples)
+
+
+def circle_pair(names, drive_radius: float, driven_radius: float) -> PitchPair:
+    """Two circular gears in mesh: one turn of the drive per cycle."""
+    ratio = drive_radius / driven_radius
+
+    def drive(tau):
+        tau = np.asarray(tau, dtype=float)
+        return np.full_like(tau, drive_radius), np.zeros_like(tau), tau, np.ones_like(tau)
+
+    def driven(tau):
+        tau = np.asarray(tau, dtype=float)
+        return (np.full_like(tau, driven_radius), np.zeros_like(tau), np.pi - ratio * tau,
+                np.full_like(tau, -ratio))
+
+    return PitchPair(tuple(names), drive_radius + driven_radius, 2 * np.pi, drive, driven,
+                     curve_periods=(2 * np.pi, 2 * np.pi / ratio))
 
 
 @dataclass(frozen=True)
@@ -107,10 +130,11 @@ def _choose_cutters(curve: ArcLengthCurve, teeth: int, system: ToothSystem, phas
     curvature = curve.curvature(s)
     concave_min = float(curvature.min())
     shaper_teeth = None
-    if concave_min < 0 or force_shaper:
-        tightest = 1.0 / -concave_min if concave_min < 0 else np.inf
-        largest = int(np.floor(2 * SHAPER_CLEARANCE * tightest / system.module))
-        shaper_teeth = min(largest, 40) if np.isfinite(tightest) else 24
+    if concave_min < 0:
+        tightest = 1.0 / -concave_min
+        shaper_teeth = min(int(np.floor(2 * SHAPER_CLEARANCE * tightest / system.module)), 40)
+    elif force_shaper:
+        shaper_teeth = 24  # a convex curve takes any pinion cutter: a common size
     cutters, concave = [], []
     for k in range(teeth):
         centre = phase + (k + 0.5) * pitch
@@ -159,11 +183,23 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
     gear = shapely.Polygon(outline)
     s = np.arange(4096) * (curve.length / 4096)
     point, _, outward = curve.frame(s)
-    blank = shapely.Polygon(point + (system.addendum_height - 1e-6) * outward)
-    # an envelope that loops inside the blank: the cutter's tip has cut into the flank
-    undercut = [k for k, boundary in enumerate(spaces)
-                if not _simple(shapely.LineString(boundary).intersection(blank))]
-    root = _tooth_thickness(curve, gear, teeth, system.pitch, phase, -0.25 * system.module)
+    pitch_region = shapely.Polygon(point)
+    curvature = curve.curvature(s)
+    # undercut: a rack-cut tooth where the pitch curve bends tighter than m ha*/sin^2(alpha)
+    # (spec), or any cutter's envelope looping in the root, below the pitch curve
+    undercut = []
+    for k, boundary in enumerate(spaces):
+        centre = phase + (k + 0.5) * system.pitch
+        near = np.abs(np.mod(s - centre + curve.length / 2, curve.length) - curve.length / 2) \
+            <= system.pitch
+        tight = cutters[k].kind == "rack" and bool(
+            (curvature[near] > 1.0 / system.undercut_radius).any())
+        looped = not _simple(shapely.LineString(boundary).intersection(pitch_region))
+        if tight or looped:
+            undercut.append(k)
+    heights = np.linspace(-(system.dedendum - system.tip_radius) * system.module, 0.0, 6)
+    root = np.min([_tooth_thickness(curve, gear, teeth, system.pitch, phase, h)
+                   for h in heights], axis=0)
     tip = _tooth_thickness(curve, gear, teeth, system.pitch, phase,
                            system.addendum_height - 1e-4 * system.module)
     pointed = [k for k, t in enumerate(tip) if not t > MIN_TIP_THICKNESS * system.module]
@@ -171,12 +207,7 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
     radial = point / np.linalg.norm(point, axis=1, keepdims=True)
     deviation = float(np.degrees(np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", radial, outward)),
                                                    0, 1))).max())
-    if concave and shaper_teeth is not None and shaper_teeth < MIN_SHAPER_TEETH:
-        problems.append(("concave_too_tight",
-                         f"the {name} gear's pitch curve is concave down to a radius of "
-                         f"{1 / -concave_min:.2f} mm (teeth {_list(concave)}): no pinion cutter "
-                         f"of at least {MIN_SHAPER_TEETH} teeth fits (module {system.module:.3f}); "
-                         "use a smaller module (more teeth) or a rounder pitch curve"))
+    problems += _check_problems(name, concave, concave_min, shaper_teeth, system)
     if undercut:
         problems.append(("undercut", f"the {name} gear's teeth {_list(undercut)} are undercut; "
                          f"remaining root thickness down to {root[undercut].min():.3f} mm: use a "
@@ -205,33 +236,76 @@ def _list(indices, limit=8):
     return shown + (f" and {len(indices) - limit} more" if len(indices) > limit else "")
 
 
-def generate_pair(pair: PitchPair, teeth: int, *, module: float | None = None,
+def mating_phase(drive_curve: ArcLengthCurve, drive_phase: float, driven_curve: ArcLengthCurve,
+                 pitch: float) -> float:
+    """Phase of the driven gear so that it meshes with the drive at the contact of ``tau = 0``.
+
+    With the drive's nearest tooth centre ``e`` behind the contact (along the
+    drive's arc), the driven gear needs a space centre ``e`` ahead of the contact
+    along its own arc (the two tangents run opposite at an external mesh).
+    """
+    s_drive = float(drive_curve.arc_of_source(np.array([0.0]))[0])
+    s_driven = float(driven_curve.arc_of_source(np.array([0.0]))[0])
+    behind = np.mod(s_drive - drive_phase, pitch)
+    return float(np.mod(s_driven + behind + pitch / 2, driven_curve.length))
+
+
+def _check_problems(name, concave, concave_min, shaper_teeth, system):
+    if concave and shaper_teeth is not None and shaper_teeth < MIN_SHAPER_TEETH:
+        return [("concave_too_tight",
+                 f"the {name} gear's pitch curve is concave down to a radius of "
+                 f"{1 / -concave_min:.2f} mm (teeth {_list(concave)}): no pinion cutter "
+                 f"of at least {MIN_SHAPER_TEETH} teeth fits (module {system.module:.3f}); "
+                 "use a smaller module (more teeth) or a rounder pitch curve")]
+    return []
+
+
+def generate_gear(name, curve: ArcLengthCurve, teeth: int, system: ToothSystem, phase: float, *,
+                  force_shaper: bool = False, bore_radius: float = 0.0, flank_points: int = 48):
+    """Tooth one gear (rack on convex stretches, shaper on concave ones) and check it."""
+    cutters, concave, concave_min, shaper_teeth = _choose_cutters(curve, teeth, system, phase,
+                                                                  force_shaper)
+    if shaper_teeth is not None and shaper_teeth < MIN_SHAPER_TEETH:
+        cutters = [CutterChoice("rack")] * teeth  # none fits: show what a rack would do
+    try:
+        # the root fillet gets half as many points as a flank (its arc is shorter): a fixed
+        # 16 left a 5e-3 mm chord error in every root (benchmarks/gears.py)
+        outline, spaces = gear_outline(curve, teeth, system, phase=phase, cutters=cutters,
+                                       flank_points=flank_points,
+                                       fillet_points=max(16, flank_points // 2))
+    except (ValueError, shapely.errors.GEOSException) as error:
+        reasons = "; ".join(m for _, m in _check_problems(name, concave, concave_min,
+                                                          shaper_teeth, system))
+        detail = reasons or f"the tooth spaces do not form a valid outline ({error})"
+        raise DesignError.single(f"gears.{name.replace(' ', '_')}", "gear_not_cuttable",
+                                 f"the {name} gear cannot be cut: {detail}") from None
+    profile = GearProfile(name, outline, curve.polyline(2048), teeth, system.module, bore_radius)
+    check = _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, concave_min,
+                        cutters, shaper_teeth)
+    return profile, check, spaces
+
+
+def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
                   system: ToothSystem | None = None, force_shaper: bool = False,
-                  bore_radius: float = 0.0, flank_points: int = 48) -> GeneratedPair:
+                  bore_radius: float = 0.0, flank_points: int = 48, drive_phase=None,
+                  drive_gear=None) -> GeneratedPair:
     """Tooth both gears of a pair, phased to assemble at ``tau = 0``, with their checks.
 
-    The module follows from the perimeter (``P / (pi z)``) unless a tooth
-    system is given, whose module must then fit the perimeter.
+    ``teeth`` is one count or (drive, driven). The module follows from the
+    perimeter (``P / (pi z)``) unless a tooth system is given. In a train, pass
+    the drive's ``drive_phase`` and already generated ``drive_gear`` (profile,
+    check, spaces) so a gear in two meshes is cut once with one phase.
     """
+    teeth = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
     curves = (pair.curve(0), pair.curve(1))
     if system is None:
-        system = ToothSystem(module if module is not None else curves[0].length / (np.pi * teeth))
-    start = (float(curves[0].arc_of_source(np.array([0.0]))[0]),
-             float(curves[1].arc_of_source(np.array([0.0]))[0]))
-    # drive: a tooth centred on the start contact; driven: a space there
-    phases = (start[0], start[1] - system.pitch / 2)
-    profiles, checks, all_spaces = [], [], []
-    for index, (name, curve, phase) in enumerate(zip(pair.names, curves, phases)):
-        cutters, concave, concave_min, shaper_teeth = _choose_cutters(curve, teeth, system, phase,
-                                                                      force_shaper)
-        if shaper_teeth is not None and shaper_teeth < MIN_SHAPER_TEETH:
-            cutters = [CutterChoice("rack")] * teeth  # none fits: show the rack's result
-        outline, spaces = gear_outline(curve, teeth, system, phase=phase, cutters=cutters,
-                                       flank_points=flank_points)
-        profiles.append(GearProfile(name, outline, curve.polyline(2048), teeth, system.module,
-                                    bore_radius))
-        checks.append(_check_gear(name, curve, teeth, system, phase, outline, spaces, concave,
-                                  concave_min, cutters, shaper_teeth))
-        all_spaces.append(spaces)
-    return GeneratedPair(pair, curves, system, teeth, tuple(profiles), tuple(checks), phases,
-                         tuple(all_spaces))
+        system = ToothSystem(module if module is not None else curves[0].length / (np.pi * teeth[0]))
+    if drive_phase is None:  # a tooth centred on the start contact
+        drive_phase = float(curves[0].arc_of_source(np.array([0.0]))[0])
+    phases = (drive_phase, mating_phase(curves[0], drive_phase, curves[1], system.pitch))
+    options = dict(force_shaper=force_shaper, bore_radius=bore_radius, flank_points=flank_points)
+    first = drive_gear or generate_gear(pair.names[0], curves[0], teeth[0], system, phases[0],
+                                        **options)
+    second = generate_gear(pair.names[1], curves[1], teeth[1], system, phases[1], **options)
+    return GeneratedPair(pair, curves, system, teeth, (first[0], second[0]),
+                         (first[1], second[1]), phases, (first[2], second[2]))

@@ -319,10 +319,13 @@ def gear_outline(curve: ArcLengthCurve, teeth: int, system: ToothSystem, *, phas
     if shaped:
         polygons += _secondary_shaper_cuts(curve, system, phase, shaped, cutters,
                                            secondary_positions)
-    removed = shapely.union_all(polygons)
-    gear = blank.difference(removed)
+    removed = shapely.make_valid(shapely.union_all(polygons))
+    gear = shapely.make_valid(blank.difference(removed))
     if gear.geom_type != "Polygon":
-        parts = sorted(getattr(gear, "geoms", [gear]), key=lambda g: -g.area)
+        parts = sorted((g for g in getattr(gear, "geoms", [gear]) if g.geom_type == "Polygon"),
+                       key=lambda g: -g.area)
+        if not parts:
+            raise ValueError("the tooth spaces leave no gear body")
         gear = parts[0]
     ring = np.asarray(gear.exterior.coords)[:-1]
     if shapely.LinearRing(ring).is_ccw is False:

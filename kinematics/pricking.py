@@ -551,6 +551,7 @@ class PrickingDesign:
     ratio_min: float
     ratio_max: float
     findings: list
+    pitch_functions: dict = field(default_factory=dict, repr=False)
 
     @property
     def gears(self):
@@ -660,6 +661,8 @@ def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pres
     for name, gear in gears.items():
         gear.table["body_angle"] = angles[name]
         gear.table["carrier_angle"] = grid_phi1
+    pitch_functions = _pitch_functions(geometry, constant, w, (sun, int1, int2, planet),
+                                       stage1_turn, total_turn)
     stage_closure = [abs(stage1_turn(curve.period) * sense - TWO_PI),
                      abs(total_turn(curve.period) * sense - TWO_PI)]
     stages = []
@@ -675,7 +678,35 @@ def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pres
                    "tip": motion.curve(motion.u(grid_v)), "needle_angle": motion.phi2(grid_v),
                    "ratio": geometry.ratio(grid_v)}
     return (curve, linkage, motion, modes, w, tuple(stages), grid_tables, deviation,
-            grid_closure, float(lowest_ratio), float(highest_ratio))
+            grid_closure, float(lowest_ratio), float(highest_ratio), pitch_functions)
+
+
+def _pitch_functions(geometry, constant, exponent, factors, stage1_turn, total_turn):
+    """Each gear's contact functions along the curve parameter: ``v -> (rho, drho, psi, dpsi)``.
+
+    ``psi`` is the polar angle of the contact point in the gear's own frame:
+    the sun ``phi1``, the first intermediate ``pi - T1``, the second ``-T1``,
+    the planet ``pi + T`` (T1, T the integrated stage-1 and total ratios).
+    """
+    sun, int1, int2, planet = factors
+    phi1 = geometry.motion.phi1
+    specs = {
+        "sun": (constant, exponent, "drive", sun, lambda v: phi1(v)),
+        "intermediate 1": (constant, exponent, "driven", int1, lambda v: np.pi - stage1_turn(v)),
+        "intermediate 2": (1.0 / constant, 1.0 - exponent, "drive", int2,
+                           lambda v: -stage1_turn(v)),
+        "planet": (1.0 / constant, 1.0 - exponent, "driven", planet,
+                   lambda v: np.pi + total_turn(v)),
+    }
+
+    def make(c, e, role, factor, angle):
+        def functions(v):
+            v = np.mod(np.asarray(v, dtype=float), geometry.motion.period)
+            rho, d_rho, _, psi_rate, _ = geometry.gear_curve(v, c, e, role, factor)
+            return rho, d_rho, angle(v), psi_rate
+        return functions
+
+    return {name: make(*spec) for name, spec in specs.items()}
 
 
 def _findings(stages, curve):
@@ -741,9 +772,10 @@ def design_pricking(points, *, rocker: float, degree: int = 3, centre=(0.0, 0.0)
         options["l"] = l * scale
     options["rocker"] = rocker * scale
     result = _design_once(centre + scale * (points - centre), **options)
-    curve, linkage, motion, modes, w, stages, grid_tables, deviation, closure, i_min, i_max = result
+    (curve, linkage, motion, modes, w, stages, grid_tables, deviation, closure, i_min, i_max,
+     functions) = result
     teeth_2 = max(min_teeth, int(round(stages[1].perimeter / (np.pi * module))))
     modules = (stages[0].perimeter / (np.pi * teeth_1), stages[1].perimeter / (np.pi * teeth_2))
     return PrickingDesign(curve, linkage, motion, modes, w, stages, float(scale),
                           (teeth_1, teeth_2), modules, grid_tables, deviation, abs(closure),
-                          i_min, i_max, _findings(stages, curve))
+                          i_min, i_max, _findings(stages, curve), functions)

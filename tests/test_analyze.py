@@ -17,9 +17,14 @@ def params():
 def test_writes_report_and_plots(params, tmp_path):
     result = run_analysis(params, output_root=tmp_path)
     folder = tmp_path / "xin2024-planter"
-    assert sorted(p.name for p in (folder / "plots").iterdir()) == [
+    plots = sorted(p.name for p in (folder / "plots").iterdir())
+    assert [p for p in plots if not p.startswith("gears-")] == [
         "absolute_paths.png", "attitude.png", "pitch_curves.png", "relative_path.png",
         "tip_velocity.png"]
+    assert len([p for p in plots if p.startswith("gears-")]) == 5   # one picture per pair
+    dxf = sorted(p.name for p in (folder / "gears").iterdir())
+    assert dxf == ["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf", "intermediate.dxf",
+                   "planet-gear-E.dxf", "sun.dxf", "train-1-planet.dxf", "train.dxf"]
     report = json.loads((folder / "report.json").read_text())
     assert report["derived"]["centre_distance_a_mm"] == pytest.approx(59.944, abs=1e-3)
     assert report["passed"] is True
@@ -31,10 +36,12 @@ def test_writes_report_and_plots(params, tmp_path):
     for png in (folder / "plots").iterdir():
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "all targets met" in result.summary_text()
+    assert "0 interfering poses" in result.summary_text()
+    assert report["gear_train"]["failures"] == []
 
 
 def test_failure_leaves_previous_outputs_untouched(params, tmp_path, monkeypatch):
-    run_analysis(params, output_root=tmp_path, plots=False)
+    run_analysis(params, output_root=tmp_path, plots=False, gears=False)
     before = (tmp_path / "xin2024-planter" / "report.json").read_bytes()
 
     import cadgen.plots
@@ -44,14 +51,14 @@ def test_failure_leaves_previous_outputs_untouched(params, tmp_path, monkeypatch
 
     monkeypatch.setattr(cadgen.plots, "planting_figures", broken)
     with pytest.raises(RuntimeError):
-        run_analysis(params, output_root=tmp_path)
+        run_analysis(params, output_root=tmp_path, gears=False)
     assert (tmp_path / "xin2024-planter" / "report.json").read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["xin2024-planter"]
 
 
 def test_same_input_same_hash(params):
-    first = run_analysis(params, output_root=None)
-    second = run_analysis(params, output_root=None)
+    first = run_analysis(params, output_root=None, gears=False)
+    second = run_analysis(params, output_root=None, gears=False)
     assert first.report["input_sha256"] == second.report["input_sha256"]
     assert first.report["metrics"] == second.report["metrics"]
 
@@ -62,6 +69,10 @@ def test_pricking_report_says_where_the_gears_are_concave(tmp_path):
     folder = tmp_path / "kernel-a"
     assert sorted(p.name for p in (folder / "plots").iterdir()) == [
         "field_paths.png", "loop.png", "pitch_curves.png", "ratio.png"]
+    # kernel-a's gears are too concave for any cutter: said, not drawn
+    assert {f["code"] for f in json.loads((folder / "report.json").read_text())
+            ["gear_train"]["failures"]} == {"gear_not_cuttable"}
+    assert "NOT CUT" in result.summary_text()
     report = json.loads((folder / "report.json").read_text())
     assert report["verified"] is True
     assert {f["code"] for f in report["findings"]} >= {"concave_pitch_curve"}

@@ -14,6 +14,7 @@ from typing import Annotated, Literal, Union
 from pydantic import BeforeValidator, Field, field_validator
 from pydantic_core import PydanticCustomError
 
+from .cutting import CuttingParameters
 from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -197,3 +198,4 @@ class PlantingParameters(_Table):
     housing: HousingParameters = HousingParameters()
     targets: DesignTargets = DesignTargets()
     resolution: ResolutionParameters = ResolutionParameters()
+    gears: CuttingParameters = CuttingParameters()

@@ -17,6 +17,7 @@ from pydantic import BeforeValidator, Field, ValidationInfo, field_validator
 from pydantic_core import PydanticCustomError
 
 from ._problems import _close_keys, _describe, _problems_error, _show
+from .cutting import CuttingParameters
 from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -153,7 +154,7 @@ SplitExponent = Union[Literal["equal-perimeter"], float]
 """``gears.split_exponent``: ``"equal-perimeter"`` or a number w in [0, 4]."""
 
 
-class GearParameters(_Table):
+class GearParameters(CuttingParameters):
     """How the total relative ratio is split into two stages, and the gear cutting data."""
 
     split_exponent: SplitExponent = Field(
@@ -161,8 +162,6 @@ class GearParameters(_Table):
         description='w in i1 = K i^w: "equal-perimeter" or a number in [0, 4]',
     )
     module: float = Field(2.0, gt=0, description="target module m, mm")
-    pressure_angle_deg: float = Field(20.0, gt=0, lt=45, description="pressure angle, deg")
-    addendum: float = Field(1.0, gt=0, description="addendum coefficient ha*, dimensionless")
     min_ratio: float = Field(
         0.05, gt=0, description="lower bound of the total relative ratio i, dimensionless"
     )
@@ -203,11 +202,6 @@ class GearParameters(_Table):
                                     f"{name} = {_show(value)} is out of range: it must be "
                                     f"from {low:g} to {high:g}")])
         return number
-
-    @property
-    def pressure_angle_rad(self) -> float:
-        """The pressure angle in radians."""
-        return math.radians(self.pressure_angle_deg)
 
 
 class PrickingFieldParameters(_Table):

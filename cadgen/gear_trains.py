@@ -1,0 +1,283 @@
+"""Every gear of a mechanism's trains: generated, phased, checked, meshed, drawn.
+
+Planting mechanism: gearbox 2's non-circular pair (central gear -> intermediate)
+and its 1:1 circular pair (D -> E), and train 1's set with converted ratio -1
+(sun -> idler 1 -> idler 2 -> planet). Pricking mechanism: stage 1 (sun ->
+first intermediate) and stage 2 (second intermediate -> planet). Every stage is
+phased at the mechanism's start position; a gear in two meshes is cut once.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinematics.errors import DesignError
+from kinematics.pitch_curves import polar_perimeter
+
+from .gear_pairs import PitchPair, circle_pair, generate_pair
+from .meshing import meshing_check, relieve_interference
+from .teeth import ToothSystem
+
+__all__ = ["GearStage", "GearTrain", "planting_train", "pricking_train", "circular_module",
+           "write_train_files", "train_report", "pair_figures"]
+
+
+@dataclass(frozen=True)
+class GearStage:
+    name: str
+    generated: object
+    meshing: object
+    placement: tuple  # (frame angle rad, drive centre (x, y)) of the pair frame at the start
+    relief: dict | None = None
+
+
+@dataclass(frozen=True)
+class GearTrain:
+    stages: tuple
+    failures: tuple = ()   # (stage name, Problem) for stages whose gears cannot be cut
+
+    @property
+    def gears(self):
+        """Each distinct gear once: (profile, check, stage, index in its pair)."""
+        seen, out = set(), []
+        for stage in self.stages:
+            for k, (profile, check) in enumerate(zip(stage.generated.profiles,
+                                                     stage.generated.checks)):
+                if profile.name not in seen:
+                    seen.add(profile.name)
+                    out.append((profile, check, stage, k))
+        return out
+
+
+def _system(cutting, module) -> ToothSystem:
+    return ToothSystem(module, pressure_angle=cutting.pressure_angle_rad, addendum=cutting.addendum,
+                       dedendum=cutting.dedendum, tip_radius=cutting.tip_radius,
+                       backlash=cutting.backlash)
+
+
+#: Circular gears get at least this many teeth: a standard rack undercuts fewer (2/sin^2(20 deg)).
+MIN_CIRCULAR_TEETH = 17
+
+
+def circular_module(radii, requested=None) -> float:
+    """The requested module, or the largest 0.05-mm step (5 mm down) giving whole tooth counts.
+
+    Only modules that give every circular gear at least ``MIN_CIRCULAR_TEETH``
+    teeth are considered, so no circular gear is undercut.
+    """
+    if requested is not None:
+        counts = [2 * r / requested for r in radii]
+        if not all(abs(c - round(c)) < 1e-6 for c in counts):
+            from kinematics.errors import DesignError
+
+            raise DesignError.single(
+                "gears.circular_module", "fractional_teeth",
+                f"module {requested:g} mm gives tooth counts {', '.join(f'{c:.3f}' for c in counts)}"
+                f" for the circular gears of radii {', '.join(f'{r:g}' for r in radii)} mm: "
+                "choose a module that divides every pitch diameter")
+        return float(requested)
+    for step in range(100, 9, -1):
+        module = step * 0.05
+        counts = [2 * r / module for r in radii]
+        if all(abs(c - round(c)) < 1e-6 and round(c) >= MIN_CIRCULAR_TEETH for c in counts):
+            return round(module, 10)
+    from kinematics.errors import DesignError
+
+    raise DesignError.single("gears.circular_module", "fractional_teeth",
+                             f"no module from 0.5 to 5 mm gives whole tooth counts for the circular "
+                             f"gears of radii {', '.join(f'{r:g}' for r in radii)} mm; set one")
+
+
+def _stage(name, pair, teeth, system, cutting, placement, drive=None):
+    bore = cutting.bore_diameter / 2
+    if drive is not None:
+        generated = generate_pair(pair, teeth, system=system, bore_radius=bore,
+                                  flank_points=cutting.flank_points, drive_phase=drive[0],
+                                  drive_gear=drive[1])
+    else:
+        generated = generate_pair(pair, teeth, system=system, bore_radius=bore,
+                                  flank_points=cutting.flank_points)
+    poses = cutting.meshing_poses or max(96, 8 * max(generated.teeth))
+    report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses)
+    relief = None
+    if report.overlap_area_max > 0.0 and drive is None:
+        # tip interference (a shaper-cut concave stretch against a tight convex one, say):
+        # relieve the drive's tips by what its mate sweeps there, then check again
+        outline, area, depth = relieve_interference(generated.profiles[0], generated.profiles[1],
+                                                    pair, report)
+        relieved = dataclasses.replace(generated.profiles[0], outline=outline)
+        generated = dataclasses.replace(generated, profiles=(relieved, generated.profiles[1]))
+        before = report
+        report = meshing_check(relieved, generated.profiles[1], pair, poses=poses)
+        relief = {"gear": relieved.name, "removed_area_mm2": area, "depth_mm": depth,
+                  "overlap_before_mm2": before.overlap_area_max,
+                  "interfering_poses_before": before.interference_poses}
+    return GearStage(name, generated, report, placement, relief)
+
+
+def _carry(generated):
+    """Phase and cut gear of a pair's driven gear, to drive the next mesh."""
+    return generated.phases[1], (generated.profiles[1], generated.checks[1], generated.spaces[1])
+
+
+def planting_train(params, mechanism) -> GearTrain:
+    """The planting mechanism's gears at the catching position (phi = 0)."""
+    cutting = params.gears
+    closure = mechanism.closure
+    curve, law, a = mechanism.pitch_curve, closure.law, closure.centre_distance
+
+    def central(t):
+        r, dr, _ = curve.radius_derivatives(t)
+        t = np.asarray(t, dtype=float)
+        return r, dr, t, np.ones_like(t)
+
+    def intermediate(t):
+        r, dr, _ = curve.radius_derivatives(t)
+        w, _ = law.ratio(t)
+        return a - r, -dr, np.pi - law.integral(t), -w
+
+    teeth = params.pitch_curve.teeth
+    pair = PitchPair(("central", "intermediate"), a, 2 * np.pi, central, intermediate)
+    box = mechanism.phic
+    C = np.asarray(mechanism.positions(np.array([0.0]), points=("C",))["C"][0])
+    module_nc = polar_perimeter(curve) / (math.pi * teeth)   # the spec: module from P and z
+    stages = [_stage("non-circular pair", pair, teeth, _system(cutting, module_nc), cutting,
+                     (box, C))]
+    # circular gears: gearbox 2's 1:1 pair and train 1's set with converted ratio -1
+    R, r = mechanism.R, mechanism.r
+    radii = [R, R * mechanism.i12, R * mechanism.i13, R, r]
+    module = circular_module(radii, cutting.circular_module)
+    system = _system(cutting, module)
+    z = [int(round(2 * x / module)) for x in radii]
+    D = C + a * np.array([math.cos(box), math.sin(box)])
+    stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), r, r),
+                         (z[4], z[4]), system, cutting, (box, D)))
+    carrier = mechanism.phi0
+    line = np.array([math.cos(carrier), math.sin(carrier)])
+    first = _stage("train 1: sun to idler 1", circle_pair(("sun", "idler 1"), radii[0], radii[1]),
+                   (z[0], z[1]), system, cutting, (carrier, np.zeros(2)))
+    second = _stage("train 1: idler 1 to idler 2",
+                    circle_pair(("idler 1", "idler 2"), radii[1], radii[2]), (z[1], z[2]), system,
+                    cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated))
+    third = _stage("train 1: idler 2 to planet",
+                   circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3]), (z[2], z[3]),
+                   system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
+                   drive=_carry(second.generated))
+    return GearTrain(tuple(stages + [first, second, third]))
+
+
+def pricking_train(params, design) -> GearTrain:
+    """The pricking mechanism's two non-circular stages at the outer dead centre."""
+    cutting = params.gears
+    functions, motion, link = design.pitch_functions, design.motion, design.linkage
+    breaks = tuple(motion.breaks)
+    stages = []
+    carrier = float(motion.phi1(0.0))
+    line = np.array([math.cos(carrier), math.sin(carrier)])
+    centre = np.asarray(link.centre, dtype=float)
+    failures = []
+    for index, (drive, driven) in enumerate((("sun", "intermediate 1"),
+                                             ("intermediate 2", "planet"))):
+        pair = PitchPair((drive, driven), link.a, motion.period, functions[drive],
+                         functions[driven], breaks=breaks)
+        system = _system(cutting, design.modules[index])
+        try:
+            stages.append(_stage(f"stage {index + 1}", pair, design.teeth[index], system, cutting,
+                                 (carrier, centre + index * link.a * line)))
+        except DesignError as error:  # reported with the gear and the reason; others go on
+            failures += [(f"stage {index + 1}", problem) for problem in error.problems]
+    return GearTrain(tuple(stages), tuple(failures))
+
+
+def _placements(train: GearTrain):
+    """Every gear at the start position: (profile, angle, centre) for the assembled sheet."""
+    out, seen = [], set()
+    for stage in train.stages:
+        frame, origin = stage.placement
+        pair = stage.generated.pair
+        rotations = pair.rotations(np.array([0.0]))
+        turn = np.array([math.cos(frame), math.sin(frame)])
+        for k, profile in enumerate(stage.generated.profiles):
+            if profile.name in seen:
+                continue
+            seen.add(profile.name)
+            centre = np.asarray(origin) + (pair.centre_distance * turn if k == 1 else 0.0)
+            out.append((profile, float(rotations[k][0] + frame), tuple(centre)))
+    return out
+
+
+def write_train_files(train: GearTrain, folder, chord_tolerance: float) -> list:
+    """One DXF per gear and an assembled sheet of the train at the start position."""
+    from .export_dxf import write_gear_dxf, write_train_sheet
+
+    written = []
+    for profile, _, _, _ in train.gears:
+        summary = write_gear_dxf(folder / f"{profile.file_stem}.dxf", profile,
+                                 chord_tolerance=chord_tolerance)
+        written.append(summary.path)
+    write_train_sheet(folder / "train.dxf", _placements(train), chord_tolerance=chord_tolerance)
+    written.append(folder / "train.dxf")
+    return written
+
+
+def train_report(train: GearTrain) -> dict:
+    gears = []
+    for profile, check, stage, _ in train.gears:
+        gears.append({
+            "gear": profile.name, "stage": stage.name, "teeth": profile.teeth,
+            "module_mm": profile.module, "cutter": check.cutter,
+            "shaper_teeth": check.shaper_teeth, "convex": check.convex,
+            "concave_teeth": check.concave_teeth, "curvature_min_per_mm": check.curvature_min,
+            "undercut_teeth": check.undercut_teeth, "root_thickness_min_mm": check.root_thickness_min,
+            "pointed_teeth": check.pointed_teeth, "tip_thickness_min_mm": check.tip_thickness_min,
+            "pressure_angle_deviation_max_deg": check.pressure_angle_deviation_max_deg,
+            "problems": [{"code": c, "message": m} for c, m in check.problems],
+            "outline_points": int(len(profile.outline)),
+        })
+    meshes = [{
+        "stage": s.name, "gears": list(s.generated.pair.names),
+        "centre_distance_mm": s.generated.pair.centre_distance,
+        "poses": s.meshing.poses, "interference_poses": s.meshing.interference_poses,
+        "overlap_area_max_mm2": s.meshing.overlap_area_max,
+        "backlash_deg": [s.meshing.backlash_min_deg, s.meshing.backlash_max_deg],
+        "backlash_arc_max_mm": s.meshing.backlash_arc_max,
+        "transmission_error_pp_deg": s.meshing.transmission_error_pp_deg,
+        "free_play_max_deg": s.meshing.free_play_max_deg,
+        "check_seconds": s.meshing.seconds,
+        "tip_relief": s.relief,
+    } for s in train.stages]
+    failures = [{"stage": stage, "path": p.path, "code": p.code, "message": p.message}
+                for stage, p in train.failures]
+    return {"gears": gears, "meshes": meshes, "failures": failures}
+
+
+def pair_figures(train: GearTrain) -> dict:
+    """A picture of each pair at the start position, problem teeth marked (PNG bytes)."""
+    from .plots import _figure, _png
+
+    figures = {}
+    for index, stage in enumerate(train.stages):
+        figure, ax = _figure(8.0, 5.0)
+        pair = stage.generated.pair
+        rotations = pair.rotations(np.array([0.0]))
+        for k, (profile, check) in enumerate(zip(stage.generated.profiles,
+                                                 stage.generated.checks)):
+            outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
+            ax.fill(outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
+                    f"({profile.teeth} teeth, {check.cutter})")
+            ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
+        m = stage.meshing
+        ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
+                     f"{m.interference_poses} interfering poses of {m.poses}, "
+                     f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
+        ax.set_aspect("equal")
+        ax.legend(fontsize=7, loc="upper right")
+        ax.grid(alpha=0.2)
+        slug = re.sub(r"[^a-z0-9]+", "-", stage.name.lower()).strip("-")
+        figures[f"gears-{index + 1}-{slug}.png"] = _png(figure)
+    return figures
