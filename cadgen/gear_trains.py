@@ -95,13 +95,13 @@ def circular_module(radii, requested=None) -> float:
 
 def _stage(name, pair, teeth, system, cutting, placement, drive=None):
     bore = cutting.bore_diameter / 2
+    options = dict(system=system, bore_radius=bore, flank_points=cutting.flank_points,
+                   force_shaper=cutting.cutter == "shaper")
     if drive is not None:
-        generated = generate_pair(pair, teeth, system=system, bore_radius=bore,
-                                  flank_points=cutting.flank_points, drive_phase=drive[0],
-                                  drive_gear=drive[1])
+        generated = generate_pair(pair, teeth, drive_phase=drive[0], drive_gear=drive[1],
+                                  **options)
     else:
-        generated = generate_pair(pair, teeth, system=system, bore_radius=bore,
-                                  flank_points=cutting.flank_points)
+        generated = generate_pair(pair, teeth, **options)
     poses = cutting.meshing_poses or max(96, 8 * max(generated.teeth))
     report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses)
     relief = None

@@ -147,3 +147,13 @@ def test_too_many_teeth_for_the_addendum_leaves_pointed_teeth():
     assert check.pointed_teeth == list(range(8))
     assert any(code == "pointed_teeth" for code, _ in check.problems)
     assert check.tip_thickness_min < 0.25 * system.module
+
+
+def test_the_file_can_ask_for_a_shaper_everywhere():
+    from tests.helpers import edited
+    from cadgen.params import validate_text
+
+    text = edited(teeth=22) + '\n[gears]\ncutter = "shaper"\nmeshing_poses = 48\n'
+    params = validate_text(text, check_feasibility=False)
+    train = planting_train(params, build_mechanism(params))
+    assert all("shaper" in g["cutter"] for g in train_report(train)["gears"])

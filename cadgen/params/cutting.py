@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 from pydantic import Field
 
@@ -14,6 +15,9 @@ __all__ = ["CuttingParameters"]
 class CuttingParameters(_Table):
     """How the gears' teeth are cut, checked and drawn (standard defaults)."""
 
+    cutter: Literal["auto", "shaper"] = Field(
+        "auto", description='"auto": rack on convex stretches, pinion cutter on concave ones; '
+                            '"shaper": a pinion cutter everywhere')
     pressure_angle_deg: float = Field(20.0, gt=0, lt=45, description="pressure angle, deg")
     addendum: float = Field(1.0, gt=0, le=2, description="addendum coefficient ha*, dimensionless")
     dedendum: float = Field(1.25, gt=0, le=2.5, description="dedendum coefficient hf*, dimensionless")
