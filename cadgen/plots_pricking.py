@@ -5,12 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from .plots import _figure, _png
+from kinematics.planar import unit as _unit
 
 __all__ = ["pricking_figures"]
-
-
-def _unit(angle):
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
 
 
 def loop(design):

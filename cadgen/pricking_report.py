@@ -2,15 +2,8 @@
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
 
 __all__ = ["pricking_report", "pricking_summary"]
-
-
-def _deg(x):
-    return float(np.degrees(x))
 
 
 def _gear(gear) -> dict:

@@ -18,6 +18,7 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 
 from .chebyshev import PiecewiseChebyshev
+from .planar import unit as _unit, perp as _perp
 
 __all__ = ["ArcLengthCurve"]
 
@@ -114,15 +115,6 @@ class ArcLengthCurve:
 
     def polyline(self, count: int = 2048):
         return self.point(np.arange(count) * (self.length / count))
-
-
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
-
-
-def _perp(vectors):
-    return np.stack([-vectors[..., 1], vectors[..., 0]], axis=-1)
 
 
 def _invert_monotone(function, targets, low, high, iterations: int = 60):

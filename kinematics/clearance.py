@@ -16,6 +16,7 @@ import numpy as np
 from . import tolerances as tol
 from .planting import CENTRE_LINE, PlantingMechanism
 from .sweep import CertifiedMinimum, certified_minimum
+from .planar import cross as _cross
 
 __all__ = [
     "segment_distances",
@@ -37,10 +38,6 @@ def _point_segment(points, starts, ends):
     along = np.where(length2 > 0.0, np.clip(along, 0.0, 1.0), 0.0)
     nearest = starts + along[..., None] * direction
     return np.linalg.norm(points - nearest, axis=-1)
-
-
-def _cross(u, v):
-    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
 def segment_distances(p0, p1, q0, q1):

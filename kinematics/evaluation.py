@@ -15,7 +15,7 @@ import numpy as np
 
 from . import tolerances as tol
 from .clearance import HousingCircle, KinematicClearance
-from .metrics import HoleMetrics, PlantEvents, hole_metrics, plant_events
+from .metrics import PlantEvents, hole_metrics, plant_events
 from .pitch_curves import polar_perimeter
 from .planting import PlantingMechanism
 

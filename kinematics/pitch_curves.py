@@ -20,7 +20,6 @@ MATLAB habit) double-counts the node at 2 pi and gives 59.997 mm instead of
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar

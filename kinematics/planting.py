@@ -17,6 +17,7 @@ import numpy as np
 
 from . import tolerances as tol
 from .pitch_curves import Closure, LimaconPitchCurve, solve_closure
+from .planar import unit as _unit, perp as _perp
 
 __all__ = ["PlantingMechanism", "PointMotion", "ARM_POINTS", "CENTRE_LINE"]
 
@@ -24,16 +25,6 @@ __all__ = ["PlantingMechanism", "PointMotion", "ARM_POINTS", "CENTRE_LINE"]
 ARM_POINTS = ("A", "B", "C", "D", "E", "P1", "N")
 #: The arm's centre line used for the kinematic arm-distance check.
 CENTRE_LINE = ("C", "E", "P1", "N")
-
-
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
-
-
-def _perp(vectors):
-    """Rotate (..., 2) vectors by +90 degrees."""
-    return np.stack([-vectors[..., 1], vectors[..., 0]], axis=-1)
 
 
 @dataclass(frozen=True)

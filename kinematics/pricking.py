@@ -31,6 +31,7 @@ from scipy.optimize import brentq
 from .chebyshev import PiecewiseChebyshev
 from .errors import ConvergenceError, DesignError, Problem
 from .spline import ClosedCurve
+from .planar import unit as _unit, cross as _cross
 
 __all__ = ["Linkage", "CarrierMotion", "GearStage", "PitchCurveReport", "PrickingDesign",
            "link_lengths", "carrier_motion", "design_pricking", "EQUAL_PERIMETER"]
@@ -39,15 +40,6 @@ TWO_PI = 2.0 * np.pi
 EQUAL_PERIMETER = "equal-perimeter"
 #: |c| may exceed 1 by this much from round-off on the curve before the point is unreachable.
 REACH_TOL = 1e-9
-
-
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
-
-
-def _cross(u, v):
-    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
 @dataclass(frozen=True)

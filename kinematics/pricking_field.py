@@ -21,15 +21,11 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .errors import DesignError, Problem
 from .pricking import PrickingDesign
+from .planar import unit as _unit
 
 __all__ = ["NeedleGeometry", "InclinationResult", "needle_geometry", "field_motion"]
 
 TWO_PI = 2.0 * np.pi
-
-
-def _unit(angle):
-    angle = np.asarray(angle, dtype=float)
-    return np.stack([np.cos(angle), np.sin(angle)], axis=-1)
 
 
 @dataclass(frozen=True)

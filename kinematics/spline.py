@@ -15,22 +15,18 @@ makes a tiny loop that passes a chord check), and where the sun centre lies.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
 from scipy.optimize import minimize_scalar
 
 from .errors import DesignError, Problem
+from .planar import cross as _cross
 
 __all__ = ["ClosedCurve", "winding_number", "self_intersections"]
 
 #: Smallest chord, as a fraction of the mean chord, before two points count as coincident.
 COINCIDENT_CHORD_RATIO = 1e-3
-
-
-def _cross(u, v):
-    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
 def self_intersections(polygon: np.ndarray) -> np.ndarray:

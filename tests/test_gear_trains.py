@@ -1,7 +1,5 @@
 """Generated gear pairs and trains: meshing, phasing, checks, hard cases, DXF round trip."""
 
-import dataclasses
-
 import ezdxf
 import numpy as np
 import pytest
