@@ -197,11 +197,14 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
     """
     draw = plots and output_root is not None
     if params.mechanism == "pricking":
-        report, figures = _pricking(params, draw, gears)
+        report, figures, train = _pricking(params, draw, gears)
     else:
-        report, figures = _planting(params, steps_per_revolution, draw, gears)
+        report, figures, train = _planting(params, steps_per_revolution, draw, gears)
+    if train is not None:
+        from .gear_trains import train_report
+
+        report["gear_train"] = train_report(train)
     if output_root is None:
-        report.pop("_train", None)
         return AnalysisResult(params.name, report, None)
     from .atomic import staged_directory
 
@@ -209,7 +212,6 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
     files = []
     with staged_directory(final) as staging:
         (staging / "plots").mkdir()
-        train = report.pop("_train", None)
         if train is not None and train.stages:
             from .gear_trains import write_train_files
 
@@ -225,55 +227,12 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
     return AnalysisResult(params.name, report, final, sorted(files))
 
 
-def _planting(params, steps_per_revolution, plots, gears=True):
-    from .design import build_mechanism, evaluate
-
-    timings: dict = {}
-    with _stage(timings, "kinematics"):
-        mechanism = build_mechanism(params)
-        mechanism.closure  # solve the closure inside its own stage
-    with _stage(timings, "metrics"):
-        evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
-    train = None
-    if gears:
-        with _stage(timings, "gears"):
-            from .gear_trains import planting_train
-
-            train = planting_train(params, mechanism)
-    figures = {}
-    if plots:
-        with _stage(timings, "plots"):
-            from .plots import planting_figures
-
-            figures = planting_figures(mechanism, evaluation)
-            figures.update(_gear_figures(train))
-    return _with_train(report_dict(params, mechanism, evaluation, timings), train), figures
-
-
-def _pricking(params, plots, gears=True):
-    from .design import pricking_design, pricking_field
-    from .pricking_report import pricking_report
-
-    timings: dict = {}
-    with _stage(timings, "inverse_design"):
-        design = pricking_design(params)
-    with _stage(timings, "field"):
-        field = pricking_field(params, design)
-    train = None
-    if gears:
-        with _stage(timings, "gears"):
-            from .gear_trains import pricking_train
-
-            train = pricking_train(params, design)
-    figures = {}
-    if plots:
-        with _stage(timings, "plots"):
-            from .plots_pricking import pricking_figures
-
-            figures = pricking_figures(params, design, field)
-            figures.update(_gear_figures(train))
-    report = pricking_report(params, design, field, timings, _versions(), input_hash(params))
-    return _with_train(report, train), figures
+def _gear_train(timings: dict, wanted: bool, build):
+    """The gear stage, timed, when it is wanted: ``build()`` makes the mechanism's train."""
+    if not wanted:
+        return None
+    with _stage(timings, "gears"):
+        return build()
 
 
 def _gear_figures(train):
@@ -284,14 +243,45 @@ def _gear_figures(train):
     return pair_figures(train)
 
 
-def _with_train(report, train):
-    """Add the gear table to the report; keep the train itself for the file writer."""
-    if train is not None:
-        from .gear_trains import train_report
+def _planting(params, steps_per_revolution, plots, gears=True):
+    from .design import build_mechanism, evaluate
+    from .gear_trains import planting_train
 
-        report["gear_train"] = train_report(train)
-        report["_train"] = train
-    return report
+    timings: dict = {}
+    with _stage(timings, "kinematics"):
+        mechanism = build_mechanism(params)
+        mechanism.closure  # solve the closure inside its own stage
+    with _stage(timings, "metrics"):
+        evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
+    train = _gear_train(timings, gears, lambda: planting_train(params, mechanism))
+    figures = {}
+    if plots:
+        with _stage(timings, "plots"):
+            from .plots import planting_figures
+
+            figures = {**planting_figures(mechanism, evaluation), **_gear_figures(train)}
+    return report_dict(params, mechanism, evaluation, timings), figures, train
+
+
+def _pricking(params, plots, gears=True):
+    from .design import pricking_design, pricking_field
+    from .gear_trains import pricking_train
+    from .pricking_report import pricking_report
+
+    timings: dict = {}
+    with _stage(timings, "inverse_design"):
+        design = pricking_design(params)
+    with _stage(timings, "field"):
+        field = pricking_field(params, design)
+    train = _gear_train(timings, gears, lambda: pricking_train(params, design))
+    figures = {}
+    if plots:
+        with _stage(timings, "plots"):
+            from .plots_pricking import pricking_figures
+
+            figures = {**pricking_figures(params, design, field), **_gear_figures(train)}
+    report = pricking_report(params, design, field, timings, _versions(), input_hash(params))
+    return report, figures, train
 
 
 def _jsonable(value):
