@@ -46,9 +46,7 @@ def evaluate(params, mechanism: PlantingMechanism | None = None, steps: int | No
     """Evaluate every design metric of a validated planting design."""
     mechanism = mechanism or build_mechanism(params)
     teeth = params.pitch_curve.teeth
-    from kinematics.pitch_curves import polar_perimeter
-
-    module = polar_perimeter(mechanism.pitch_curve) / (math.pi * teeth)
+    module = mechanism.module(teeth)
     return evaluate_planting(
         mechanism, teeth=teeth, depth=params.field.depth, spacings=params.field.plant_spacings,
         carrier_speed_rpm=params.field.carrier_speed_rpm,

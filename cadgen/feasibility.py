@@ -6,11 +6,10 @@ the field path a designer should change, never raises for a bad design.
 
 from __future__ import annotations
 
-import math
 
 from kinematics.errors import ConvergenceError, DesignError, Problem
 from kinematics.metrics import vertical_extremes
-from kinematics.pitch_curves import pair_problems, polar_perimeter
+from kinematics.pitch_curves import pair_problems
 
 __all__ = ["design_problems"]
 
@@ -29,7 +28,7 @@ def design_problems(params) -> list:
     try:
         mechanism = build_mechanism(params)
         closure = mechanism.closure
-        module = polar_perimeter(mechanism.pitch_curve) / (math.pi * params.pitch_curve.teeth)
+        module = mechanism.module(params.pitch_curve.teeth)
     except DesignError as error:
         return list(error.problems)
     except ConvergenceError as error:

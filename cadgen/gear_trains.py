@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinematics.errors import DesignError
-from kinematics.pitch_curves import polar_perimeter
 
 from .gear_pairs import PitchPair, circle_pair, generate_pair
 from .meshing import meshing_check, relieve_interference
@@ -145,7 +144,7 @@ def planting_train(params, mechanism) -> GearTrain:
     pair = PitchPair(("central", "intermediate"), a, 2 * np.pi, central, intermediate)
     box = mechanism.phic
     C = np.asarray(mechanism.positions(np.array([0.0]), points=("C",))["C"][0])
-    module_nc = polar_perimeter(curve) / (math.pi * teeth)   # the spec: module from P and z
+    module_nc = mechanism.module(teeth)   # the spec: module from perimeter and z
     stages = [_stage("non-circular pair", pair, teeth, _system(cutting, module_nc), cutting,
                      (box, C))]
     # circular gears: gearbox 2's 1:1 pair and train 1's set with converted ratio -1

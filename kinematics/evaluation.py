@@ -16,7 +16,6 @@ import numpy as np
 from . import tolerances as tol
 from .clearance import HousingCircle, KinematicClearance
 from .metrics import PlantEvents, hole_metrics, plant_events
-from .pitch_curves import polar_perimeter
 from .planting import PlantingMechanism
 
 __all__ = ["Targets", "MetricResult", "PlantingEvaluation", "evaluate_planting",
@@ -128,8 +127,8 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
     """
     omega = 2.0 * np.pi * carrier_speed_rpm / 60.0
     closure = mechanism.closure
-    perimeter = polar_perimeter(mechanism.pitch_curve)
-    module = perimeter / (np.pi * teeth)
+    perimeter = mechanism.pitch_perimeter
+    module = mechanism.module(teeth)
     tip = mechanism.tip_path()
     events = plant_events(tip, depth, steps=steps)
     holes = [hole_metrics(tip, events, float(s), steps=steps) for s in spacings]

@@ -16,7 +16,7 @@ from functools import cached_property
 import numpy as np
 
 from . import tolerances as tol
-from .pitch_curves import Closure, LimaconPitchCurve, solve_closure
+from .pitch_curves import Closure, LimaconPitchCurve, polar_perimeter, solve_closure
 from .planar import unit as _unit, perp as _perp
 
 __all__ = ["PlantingMechanism", "PointMotion", "ARM_POINTS", "CENTRE_LINE"]
@@ -85,6 +85,15 @@ class PlantingMechanism:
     def closure(self) -> Closure:
         """The 1:1 closure of the non-circular pair (centre distance a)."""
         return solve_closure(self.pitch_curve, rtol=self.closure_rtol)
+
+    @cached_property
+    def pitch_perimeter(self) -> float:
+        """Perimeter of the central gear's pitch curve ``rho = r1(t)`` (mm)."""
+        return polar_perimeter(self.pitch_curve)
+
+    def module(self, teeth: int) -> float:
+        """Module of the non-circular pair with ``teeth`` teeth: perimeter / (pi z) (spec)."""
+        return self.pitch_perimeter / (np.pi * teeth)
 
     @property
     def centre_distance(self) -> float:
