@@ -104,6 +104,8 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None):
     poses = cutting.meshing_poses or max(96, 8 * max(generated.teeth))
     report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses)
     relief = None
+    # relieve only a drive cut for this mesh alone: a drive that already meshes elsewhere (an
+    # idler of train 1) is not re-cut here; any interference there stays in the report
     if report.overlap_area_max > 0.0 and drive is None:
         # tip interference (a shaper-cut concave stretch against a tight convex one, say):
         # relieve the drive's tips by what its mate sweeps there, then check again

@@ -48,14 +48,16 @@ def test_crossings_are_on_the_surface_line_and_bracket_the_bottom(case):
         assert r.time_in_soil_deg == pytest.approx(r.exit_progress_deg - r.entry_progress_deg)
 
 
-def test_entry_angle_formula_at_the_crossing(case):
+def test_entry_angle_from_the_needle_positions_at_the_crossing(case):
     design, results = case
     model = _FieldModel(design, RPM, SPEED)
     for r in results:
-        axis = model.axis(np.array([r.entry_parameter]))[0]
+        at = np.array([r.entry_parameter])
         theta = np.radians(r.inclination_deg)
-        # the needle axis against the surface, its vertical component scaled once by cos(theta)
-        direction = np.array([np.cos(axis), np.sin(axis) * np.cos(theta)])
+        # second method: the needle as the segment from its root to its tip (positions, not the
+        # axis angle), projected into the hole's plane: vertical component scaled once
+        needle = model.tip(at)[0] - model.root(at)[0]
+        direction = np.array([needle[0], needle[1] * np.cos(theta)])
         expected = np.degrees(np.arctan2(abs(direction[1]), abs(direction[0])))
         assert r.entry_angle_deg == pytest.approx(expected, abs=1e-9)
 
