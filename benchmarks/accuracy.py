@@ -89,7 +89,7 @@ def sampled_metrics(steps):
     out[("arm_distance", None)] = polyline_distance(_centre_line(m, half, 0),
                                                     _centre_line(m, half, 1)).min()
     perimeter = polar_perimeter(m.pitch_curve)
-    circles = default_housing_circles(m, perimeter / (np.pi * TEETH), 6.0)
+    circles = default_housing_circles(m, perimeter / (np.pi * TEETH), 6.0)  # tip + 6 mm
     out[("ground_clearance", None)] = (_lowest_of_circles(m, circles, phi) - soil).min()
     out[("module", None)] = perimeter / (np.pi * TEETH)
     return out

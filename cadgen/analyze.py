@@ -186,24 +186,35 @@ def format_gear_table(gear_train: dict) -> str:
     return "\n".join(lines)
 
 
+@dataclass
+class _Outcome:
+    """What a mechanism's analysis hands to the writer: the report, PNGs and file writers.
+
+    Each writer takes the staging directory and returns the paths it wrote,
+    relative to it; they run inside the staged (atomic) output directory.
+    """
+
+    report: dict
+    figures: dict = field(default_factory=dict)
+    writers: list = field(default_factory=list)
+
+
 def run_analysis(params, output_root: Path | str | None = Path("outputs"),
                  steps_per_revolution: int | None = None, plots: bool = True,
-                 gears: bool = True) -> AnalysisResult:
+                 gears: bool = True, cam: bool = True) -> AnalysisResult:
     """Analyse one validated design; write ``<output_root>/<name>/`` atomically.
 
     With ``output_root=None`` nothing is written (the report is still returned).
     ``gears`` generates, checks and meshes every gear of the trains and writes
-    their DXF files under ``gears/``.
+    their DXF files under ``gears/``; ``cam`` designs the planting mechanism's
+    duckbill cam and writes ``cam.dxf`` (when the roller can follow the contour).
     """
     draw = plots and output_root is not None
     if params.mechanism == "pricking":
-        report, figures, train = _pricking(params, draw, gears)
+        outcome = _pricking(params, draw, gears)
     else:
-        report, figures, train = _planting(params, steps_per_revolution, draw, gears)
-    if train is not None:
-        from .gear_trains import train_report
-
-        report["gear_train"] = train_report(train)
+        outcome = _planting(params, steps_per_revolution, draw, gears, cam)
+    report = outcome.report
     if output_root is None:
         return AnalysisResult(params.name, report, None)
     from .atomic import staged_directory
@@ -212,14 +223,9 @@ def run_analysis(params, output_root: Path | str | None = Path("outputs"),
     files = []
     with staged_directory(final) as staging:
         (staging / "plots").mkdir()
-        if train is not None and train.stages:
-            from .gear_trains import write_train_files
-
-            (staging / "gears").mkdir()
-            for path in write_train_files(train, staging / "gears",
-                                          params.gears.chord_tolerance):
-                files.append(f"gears/{Path(path).name}")
-        for name, data in figures.items():
+        for writer in outcome.writers:
+            files += [str(path) for path in writer(staging)]
+        for name, data in outcome.figures.items():
             (staging / "plots" / name).write_bytes(data)
             files.append(f"plots/{name}")
         (staging / "report.json").write_text(json.dumps(report, indent=2, default=_jsonable) + "\n")
@@ -235,17 +241,28 @@ def _gear_train(timings: dict, wanted: bool, build):
         return build()
 
 
-def _gear_figures(train):
-    if train is None or not train.stages:
-        return {}
-    from .gear_trains import pair_figures
+def _with_train(outcome: _Outcome, train, chord_tolerance: float) -> _Outcome:
+    """Add the gear train's report section, pictures and DXF writer to an outcome."""
+    if train is None:
+        return outcome
+    from .gear_trains import train_report, write_train_files
 
-    return pair_figures(train)
+    outcome.report["gear_train"] = train_report(train)
+    if not train.stages:
+        return outcome
+
+    def write(staging):
+        (staging / "gears").mkdir()
+        return [f"gears/{Path(path).name}"
+                for path in write_train_files(train, staging / "gears", chord_tolerance)]
+
+    outcome.writers.append(write)
+    return outcome
 
 
-def _planting(params, steps_per_revolution, plots, gears=True):
+def _planting(params, steps_per_revolution, plots, gears=True, cam=True) -> _Outcome:
     from .design import build_mechanism, evaluate
-    from .gear_trains import planting_train
+    from .gear_trains import pair_figures, planting_train
 
     timings: dict = {}
     with _stage(timings, "kinematics"):
@@ -254,34 +271,72 @@ def _planting(params, steps_per_revolution, plots, gears=True):
     with _stage(timings, "metrics"):
         evaluation = evaluate(params, mechanism, steps=steps_per_revolution)
     train = _gear_train(timings, gears, lambda: planting_train(params, mechanism))
+    cam_design = None
+    if cam:
+        from .cam_design import design_cam
+
+        with _stage(timings, "cam"):
+            cam_design = design_cam(params, mechanism, evaluation.events)
     figures = {}
     if plots:
         with _stage(timings, "plots"):
             from .plots import planting_figures
 
-            figures = {**planting_figures(mechanism, evaluation), **_gear_figures(train)}
-    return report_dict(params, mechanism, evaluation, timings), figures, train
+            figures = planting_figures(mechanism, evaluation)
+            if train is not None and train.stages:
+                figures.update(pair_figures(train))
+            if cam_design is not None:
+                from .plots_cam import cam_figures
+
+                figures.update(cam_figures(cam_design, params.cam.profile_points))
+    outcome = _Outcome(report_dict(params, mechanism, evaluation, timings), figures)
+    if cam_design is not None:
+        outcome.report["cam"] = _cam_section(cam_design, params)
+        if cam_design.cuttable:
+            outcome.writers.append(lambda staging: _write_cam(staging, cam_design, params))
+    return _with_train(outcome, train, params.gears.chord_tolerance)
 
 
-def _pricking(params, plots, gears=True):
+def _cam_section(design, params) -> dict:
+    from .cam_design import cam_report
+
+    section = cam_report(design)
+    if not design.cuttable:
+        section["not_written"] = "cam.dxf is not written: the roller cannot follow this contour"
+    return section
+
+
+def _write_cam(staging, design, params):
+    from .export_dxf import write_cam_dxf
+
+    points = params.cam.profile_points
+    write_cam_dxf(staging / "cam.dxf", design.profile.working_profile(points),
+                  design.profile.pitch_curve(points), bore_radius=params.cam.bore_diameter / 2,
+                  chord_tolerance=params.gears.chord_tolerance)
+    return ["cam.dxf"]
+
+
+def _pricking(params, plots, gears=True) -> _Outcome:
     from .design import pricking_design, pricking_field
-    from .gear_trains import pricking_train
+    from .gear_trains import pair_figures, pricking_train
     from .pricking_report import pricking_report
 
     timings: dict = {}
     with _stage(timings, "inverse_design"):
         design = pricking_design(params)
     with _stage(timings, "field"):
-        field = pricking_field(params, design)
+        field_motion = pricking_field(params, design)
     train = _gear_train(timings, gears, lambda: pricking_train(params, design))
     figures = {}
     if plots:
         with _stage(timings, "plots"):
             from .plots_pricking import pricking_figures
 
-            figures = {**pricking_figures(params, design, field), **_gear_figures(train)}
-    report = pricking_report(params, design, field, timings, _versions(), input_hash(params))
-    return report, figures, train
+            figures = pricking_figures(params, design, field_motion)
+            if train is not None and train.stages:
+                figures.update(pair_figures(train))
+    report = pricking_report(params, design, field_motion, timings, _versions(), input_hash(params))
+    return _with_train(_Outcome(report, figures), train, params.gears.chord_tolerance)
 
 
 def _jsonable(value):

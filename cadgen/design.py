@@ -7,12 +7,13 @@ from functools import lru_cache
 
 import numpy as np
 
-from kinematics.clearance import HousingCircle
-from kinematics.evaluation import Targets, default_housing_circles, evaluate_planting
+from kinematics.evaluation import Targets, evaluate_planting
 from kinematics.pitch_curves import LimaconPitchCurve
 from kinematics.planting import PlantingMechanism
 
-__all__ = ["build_mechanism", "housing_circles", "targets_of", "evaluate", "pricking_design",
+from .housings import housing_circles
+
+__all__ = ["build_mechanism", "targets_of", "evaluate", "pricking_design",
            "pricking_field"]
 
 
@@ -30,14 +31,6 @@ def build_mechanism(params) -> PlantingMechanism:
         closure_rtol=params.resolution.closure_rtol)
 
 
-def housing_circles(params, mechanism: PlantingMechanism, module: float):
-    """Envelope circles: derived from the gear sizes, with any explicit radius in the file winning."""
-    circles = default_housing_circles(mechanism, module, params.housing.wall)
-    explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
-    return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
-            for c in circles]
-
-
 def targets_of(params) -> Targets:
     return Targets(**params.targets.model_dump())
 
@@ -46,11 +39,10 @@ def evaluate(params, mechanism: PlantingMechanism | None = None, steps: int | No
     """Evaluate every design metric of a validated planting design."""
     mechanism = mechanism or build_mechanism(params)
     teeth = params.pitch_curve.teeth
-    module = mechanism.module(teeth)
     return evaluate_planting(
         mechanism, teeth=teeth, depth=params.field.depth, spacings=params.field.plant_spacings,
         carrier_speed_rpm=params.field.carrier_speed_rpm,
-        housing_circles=housing_circles(params, mechanism, module),
+        housing_circles=housing_circles(params, mechanism),
         targets=targets_of(params),
         steps=steps or params.resolution.steps_per_revolution)
 

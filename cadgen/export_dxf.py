@@ -51,6 +51,7 @@ __all__ = [
     "LAYERS",
     "write_gear_dxf",
     "write_train_sheet",
+    "write_cam_dxf",
 ]
 
 #: Layer name -> AutoCAD colour index (7 = white/black, 1 red, 3 green, 4 cyan, 2 yellow).
@@ -70,6 +71,8 @@ _CENTRE_LINETYPE_PATTERN = [20.0, 12.0, -3.0, 2.0, -3.0]
 DXF_VERSION = "R2010"
 #: Half length of each centre-mark line, in modules (the whole mark is two modules wide).
 CENTRE_MARK_HALF_LENGTH_MODULES = 1.0
+#: Half length of each centre-mark line of a cam drawing (mm).
+CAM_CENTRE_MARK_HALF_LENGTH = 5.0
 #: Height of the gear labels on the train sheet (mm) and their gap below the gear, in modules.
 LABEL_HEIGHT = 3.5
 LABEL_GAP_MODULES = 2.0
@@ -163,22 +166,29 @@ def _ring_problems(label: str, points: np.ndarray) -> list[str]:
 
 def _gear_problems(profile, *, label: str | None = None) -> list[str]:
     """Every problem of one gear profile, each naming the bad value."""
-    import shapely
-
     label = label or f"gear {getattr(profile, 'name', '?')!r}"
-    problems = []
-    outline = _closed_points(profile.outline)
-    outline_problems = _ring_problems(f"{label}: outline", outline)
-    problems += outline_problems
-    problems += _ring_problems(f"{label}: pitch_curve", _closed_points(profile.pitch_curve))
+    problems = _plate_problems(profile.outline, profile.pitch_curve, profile.centre,
+                               profile.bore_radius, label)
     module = profile.module
     if not (isinstance(module, (int, float, np.number)) and math.isfinite(module) and module > 0):
         problems.append(f"{label}: module must be a finite number > 0, got {module!r}")
-    centre = np.asarray(profile.centre, dtype=float)
+    return problems
+
+
+def _plate_problems(outline, pitch_curve, centre, bore, label: str) -> list[str]:
+    """Problems of a cut plate (gear or cam): outline, pitch curve, centre, bore inside the outline."""
+    import shapely
+
+    problems = []
+    outline = _closed_points(outline)
+    outline_problems = _ring_problems(f"{label}: outline", outline)
+    problems += outline_problems
+    problems += _ring_problems(f"{label}: pitch_curve", _closed_points(pitch_curve))
+    given_centre = centre
+    centre = np.asarray(centre, dtype=float)
     if centre.shape != (2,) or not np.isfinite(centre).all():
-        problems.append(f"{label}: centre must be two finite numbers, got {profile.centre!r}")
+        problems.append(f"{label}: centre must be two finite numbers, got {given_centre!r}")
         return problems
-    bore = profile.bore_radius
     if not (isinstance(bore, (int, float, np.number)) and math.isfinite(bore) and bore >= 0):
         problems.append(f"{label}: bore_radius must be a finite number >= 0, got {bore!r}")
     elif bore > 0 and not outline_problems:
@@ -491,3 +501,29 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
         summaries.append(DxfSummary(path, len(outline), used, area, perimeter))
     write_bytes_atomic(path, _audited_bytes(doc, path))
     return tuple(summaries)
+
+
+def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius: float = 0.0,
+                  chord_tolerance: float = 0.005, label: str = "cam") -> DxfSummary:
+    """Write a plate cam as a DXF cutting file (mm), laid out like a gear file.
+
+    ``contour`` (the working profile) goes on ``OUTLINE`` as the one closed cutting
+    path, ``pitch_curve`` (the roller centre's path) on ``PITCH``, the bore on
+    ``BORE`` and a 10-mm centre mark at the origin (the cam's axis) on ``CENTRE``.
+    Thinning, audit, atomic and deterministic writing as :func:`write_gear_dxf`.
+    """
+    tolerance = _check_tolerance(chord_tolerance)
+    centre = np.zeros(2)
+    problems = _plate_problems(contour, pitch_curve, centre, bore_radius, label)
+    if problems:
+        raise DxfInputError(f"cannot export {label} to DXF", problems)
+    path = Path(path)
+    keep_clear = (centre, float(bore_radius)) if bore_radius > 0 else None
+    outline, used = _thin_ring(_closed_points(contour), tolerance, keep_clear=keep_clear)
+    pitch, _ = _thin_ring(_closed_points(pitch_curve), tolerance)
+    doc = _new_document()
+    _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
+              CAM_CENTRE_MARK_HALF_LENGTH / CENTRE_MARK_HALF_LENGTH_MODULES)
+    write_bytes_atomic(path, _audited_bytes(doc, path))
+    area, perimeter = _ring_measures(outline)
+    return DxfSummary(path, len(outline), used, area, perimeter)

@@ -19,7 +19,8 @@ def design_problems(params) -> list:
 
     Checks: the pitch curve closes (and is not pointed); both non-circular
     gears' smallest radii clear the cutting limit for the module; the planting
-    depth leaves the tip a way out of the soil.
+    depth leaves the tip a way out of the soil; the duckbill linkage can open
+    the mouth the pot needs; the cam's phases fit the revolution.
     """
     if params.mechanism == "pricking":
         return _pricking_problems(params)
@@ -44,6 +45,28 @@ def design_problems(params) -> list:
             "field.depth", "no_soil_crossing",
             f"planting depth {params.field.depth:g} mm is not less than the tip path's height "
             f"{height:.3f} mm: the tip never leaves the soil"))
+        return problems
+    return _cam_problems(params, mechanism)
+
+
+def _cam_problems(params, mechanism) -> list:
+    """The duckbill linkage and the cam's timing (checks of the contour itself are reported, not
+    refused: a designer wants to see the cam that fails)."""
+    from kinematics.metrics import plant_events
+
+    from .cam_design import linkage_of, timing_of
+
+    problems = []
+    try:
+        linkage_of(params)
+    except DesignError as error:
+        problems += error.problems
+    try:
+        events = plant_events(mechanism.tip_path(), params.field.depth,
+                              steps=params.resolution.steps_per_revolution)
+        timing_of(params, mechanism, events)
+    except DesignError as error:
+        problems += error.problems
     return problems
 
 

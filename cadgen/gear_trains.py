@@ -19,6 +19,7 @@ import numpy as np
 from kinematics.errors import DesignError
 
 from .gear_pairs import PitchPair, circle_pair, generate_pair
+from .housings import circular_module, planting_circular_radii
 from .meshing import meshing_check, relieve_interference
 from .teeth import ToothSystem
 
@@ -57,39 +58,6 @@ def _system(cutting, module) -> ToothSystem:
     return ToothSystem(module, pressure_angle=cutting.pressure_angle_rad, addendum=cutting.addendum,
                        dedendum=cutting.dedendum, tip_radius=cutting.tip_radius,
                        backlash=cutting.backlash)
-
-
-#: Circular gears get at least this many teeth: a standard rack undercuts fewer (2/sin^2(20 deg)).
-MIN_CIRCULAR_TEETH = 17
-
-
-def circular_module(radii, requested=None) -> float:
-    """The requested module, or the largest 0.05-mm step (5 mm down) giving whole tooth counts.
-
-    Only modules that give every circular gear at least ``MIN_CIRCULAR_TEETH``
-    teeth are considered, so no circular gear is undercut.
-    """
-    if requested is not None:
-        counts = [2 * r / requested for r in radii]
-        if not all(abs(c - round(c)) < 1e-6 for c in counts):
-            from kinematics.errors import DesignError
-
-            raise DesignError.single(
-                "gears.circular_module", "fractional_teeth",
-                f"module {requested:g} mm gives tooth counts {', '.join(f'{c:.3f}' for c in counts)}"
-                f" for the circular gears of radii {', '.join(f'{r:g}' for r in radii)} mm: "
-                "choose a module that divides every pitch diameter")
-        return float(requested)
-    for step in range(100, 9, -1):
-        module = step * 0.05
-        counts = [2 * r / module for r in radii]
-        if all(abs(c - round(c)) < 1e-6 and round(c) >= MIN_CIRCULAR_TEETH for c in counts):
-            return round(module, 10)
-    from kinematics.errors import DesignError
-
-    raise DesignError.single("gears.circular_module", "fractional_teeth",
-                             f"no module from 0.5 to 5 mm gives whole tooth counts for the circular "
-                             f"gears of radii {', '.join(f'{r:g}' for r in radii)} mm; set one")
 
 
 def _stage(name, pair, teeth, system, cutting, placement, drive=None):
@@ -150,13 +118,12 @@ def planting_train(params, mechanism) -> GearTrain:
     stages = [_stage("non-circular pair", pair, teeth, _system(cutting, module_nc), cutting,
                      (box, C))]
     # circular gears: gearbox 2's 1:1 pair and train 1's set with converted ratio -1
-    R, r = mechanism.R, mechanism.r
-    radii = [R, R * mechanism.i12, R * mechanism.i13, R, r]
+    radii = planting_circular_radii(mechanism)
     module = circular_module(radii, cutting.circular_module)
     system = _system(cutting, module)
     z = [int(round(2 * x / module)) for x in radii]
     D = C + a * np.array([math.cos(box), math.sin(box)])
-    stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), r, r),
+    stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), mechanism.r, mechanism.r),
                          (z[4], z[4]), system, cutting, (box, D)))
     carrier = mechanism.phi0
     line = np.array([math.cos(carrier), math.sin(carrier)])

@@ -9,13 +9,14 @@ import numpy as np
 __all__ = ["planting_figures"]
 
 
-def _figure(width=7.5, height=5.0):
+def _figure(width=7.5, height=5.0, **layout):
+    """A figure and its axes; ``layout`` goes to ``plt.subplots`` (``nrows=2, sharex=True``)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    figure, axes = plt.subplots(figsize=(width, height), dpi=110)
+    figure, axes = plt.subplots(figsize=(width, height), dpi=110, **layout)
     return figure, axes
 
 

@@ -19,13 +19,15 @@ def test_writes_report_and_plots(params, tmp_path):
     folder = tmp_path / "xin2024-planter"
     plots = sorted(p.name for p in (folder / "plots").iterdir())
     assert [p for p in plots if not p.startswith("gears-")] == [
-        "absolute_paths.png", "attitude.png", "pitch_curves.png", "relative_path.png",
-        "tip_velocity.png"]
+        "absolute_paths.png", "attitude.png", "cam-contour.png", "cam-follower.png",
+        "pitch_curves.png", "relative_path.png", "tip_velocity.png"]
     assert len([p for p in plots if p.startswith("gears-")]) == 5   # one picture per pair
     dxf = sorted(p.name for p in (folder / "gears").iterdir())
     assert dxf == ["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf", "intermediate.dxf",
                    "planet-gear-E.dxf", "sun.dxf", "train-1-planet.dxf", "train.dxf"]
+    assert (folder / "cam.dxf").is_file()
     report = json.loads((folder / "report.json").read_text())
+    assert report["cam"]["cuttable"] and report["cam"]["problems"] == []
     assert report["derived"]["centre_distance_a_mm"] == pytest.approx(59.944, abs=1e-3)
     assert report["passed"] is True
     assert {m["key"] for m in report["metrics"]} >= {

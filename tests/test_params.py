@@ -52,7 +52,7 @@ EXPECTED = {
     "empty_spacings.toml": {("field.plant_spacings", "empty")},
     "bad_name.toml": {("name", "invalid_name")},
     "housing_keys.toml": {
-        ("housing.wall", "out_of_range"),
+        ("housing.wall", "wall_too_thin"),
         ("housing.gearbox1.D", "unknown_key"),
         ("housing.gearbox1.B", "out_of_range"),
     },
@@ -115,7 +115,7 @@ def test_n_independent_errors_in_different_tables_are_all_reported():
         "train.r": ("r = 27.0 ", "r = -27.0 "),
         "planter.L1": ("L1 = 130.0 ", "L1 = inf "),
         "field.carrier_speed_rpm": ("carrier_speed_rpm = 30.0 ", "carrier_speed_rpm = 0 "),
-        "housing.wall": ("wall = 6.0 ", "wall = true "),
+        "housing.axial_gap": ("axial_gap = 2.0 ", "axial_gap = true "),
         "targets.hole_width_max": ("hole_width_max = 30.0 ", "hole_width_max = -30.0 "),
         "resolution.closure_rtol": ("closure_rtol = 1e-13 ", "closure_rtol = 1e-20 "),
     }
@@ -291,7 +291,8 @@ def test_reference_values_equal_the_spec():
     assert params.field.depth == 35.0
     assert params.field.plant_spacings == (150.0, 185.0, 200.0)
     assert params.field.carrier_speed_rpm == 30.0
-    assert params.housing.wall == 6.0
+    assert params.housing.wall is None and params.housing.clearance is None  # derived
+    assert params.housing.axial_gap == 2.0
     assert params.housing.gearbox1 is None and params.housing.gearbox2 is None
     targets = params.targets
     assert targets.trajectory_height_min == 500.0
@@ -317,7 +318,7 @@ def test_reference_comments_name_every_quantity():
 
 def test_optional_tables_take_the_defaults():
     text = _reference_text()
-    text = text[: text.index("# Kinematic envelope")]  # drop [housing], [targets], [resolution]
+    text = text[: text.index("# Gearbox housings")]  # drop [housing] and every table after it
     text = _replace(text, "carrier_speed_rpm = 30.0                # carrier-1 speed, r/min\n", "")
     params = validate_text(text, check_feasibility=False)
     reference = load_params(REFERENCE, check_feasibility=False)

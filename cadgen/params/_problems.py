@@ -189,7 +189,7 @@ _RELATIONS = {
     "less_than_equal": ("le", "at most"),
 }
 
-_CUSTOM_CODES = {"inconsistent", "not_allowed"}
+_CUSTOM_CODES = {"inconsistent", "not_allowed", "wall_too_thin"}
 
 
 def _problems_from_error(error: Mapping[str, Any], root: Any) -> list[Problem]:

@@ -36,6 +36,14 @@ class CuttingParameters(_Table):
         None, gt=0, description="module of the trains' circular gears, mm (default: the largest "
                                 "0.05-mm step that gives every one a whole tooth count)")
 
+    face_width: float | None = Field(
+        None, gt=0, description="face width of every gear, mm (default: 6 modules of each gear, "
+                                "to 0.5 mm)")
+
+    def face_width_for(self, module: float) -> float:
+        """The face width given, or 6 modules rounded to 0.5 mm (mm)."""
+        return self.face_width if self.face_width is not None else max(0.5, round(12.0 * module) / 2)
+
     @property
     def pressure_angle_rad(self) -> float:
         return math.radians(self.pressure_angle_deg)

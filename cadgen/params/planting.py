@@ -14,7 +14,9 @@ from typing import Annotated, Literal, Union
 from pydantic import BeforeValidator, Field, field_validator
 from pydantic_core import PydanticCustomError
 
+from .cam import CamParameters
 from .cutting import CuttingParameters
+from .solids import GroundParameters, ShellParameters, SolidsParameters
 from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -105,10 +107,13 @@ class TrainParameters(_Table):
 
 
 class PlanterParameters(_Table):
-    """Planting arm lengths."""
+    """Planting arm lengths, and the planter shell's sizes for the solids."""
 
     L1: float = Field(gt=0, description="L1: E to P1, mm")
     L2: float = Field(gt=0, description="L2: P1 to the duckbill tip N, mm")
+    arm_width: float = Field(28.0, gt=0, description="width of the arm plate from E to P1, mm")
+    arm_thickness: float = Field(8.0, gt=0, description="thickness of the arm plate, mm")
+    shell_wall: float = Field(2.5, gt=0, description="wall of the planter tube and blades, mm")
 
 
 class FieldParameters(_Table):
@@ -157,10 +162,13 @@ class Gearbox2Envelope(_Envelope):
     E: float | None = Field(None, gt=0)
 
 
-class HousingParameters(_Table):
-    """Kinematic envelope circles of the gearbox housings."""
+class HousingParameters(ShellParameters):
+    """The gearbox housings: shells round their gears, and optional explicit envelope radii.
 
-    wall: float = Field(6.0, ge=0, description="largest gear tip to housing outside, mm")
+    The kinematic envelope circle about each axis is the largest gear tip there plus
+    ``clearance`` plus ``wall``: the outside of the solid housing.
+    """
+
     gearbox1: Gearbox1Envelope | None = None
     gearbox2: Gearbox2Envelope | None = None
 
@@ -199,3 +207,6 @@ class PlantingParameters(_Table):
     targets: DesignTargets = DesignTargets()
     resolution: ResolutionParameters = ResolutionParameters()
     gears: CuttingParameters = CuttingParameters()
+    cam: CamParameters = CamParameters()
+    ground: GroundParameters = GroundParameters()
+    solids: SolidsParameters = SolidsParameters()

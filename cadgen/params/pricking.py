@@ -18,6 +18,7 @@ from pydantic_core import PydanticCustomError
 
 from ._problems import _close_keys, _describe, _problems_error, _show
 from .cutting import CuttingParameters
+from .solids import GroundParameters, ShellParameters, SolidsParameters
 from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -148,6 +149,9 @@ class LinkageParameters(_Table):
     tip_reach: float | None = Field(
         None, gt=0, description="l, planet centre B to the needle tip D, mm (normally derived)"
     )
+    rocker_width: float = Field(16.0, gt=0, description="width of the rocker bar (solids), mm")
+    rocker_thickness: float = Field(8.0, gt=0, description="thickness of the rocker bar (solids), mm")
+    needle_diameter: float = Field(8.0, gt=0, description="diameter of the needle (solids), mm")
 
 
 SplitExponent = Union[Literal["equal-perimeter"], float]
@@ -245,4 +249,7 @@ class PrickingParameters(_Table):
     gears: GearParameters = GearParameters()
     field: PrickingFieldParameters
     resolution: PrickingResolutionParameters = PrickingResolutionParameters()
+    housing: ShellParameters = ShellParameters()
+    ground: GroundParameters = GroundParameters()
+    solids: SolidsParameters = SolidsParameters()
 

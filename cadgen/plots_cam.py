@@ -1,0 +1,80 @@
+"""Plots of the duckbill cam: follower motion and blade opening over the carrier angle, the contour."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .plots import _figure, _png
+
+__all__ = ["cam_figures"]
+
+_EVENT_STYLE = {"entry": "tab:brown", "lowest": "k", "exit": "tab:brown",
+                "seedling_cleared": "tab:green"}
+
+
+def follower_motion(design) -> bytes:
+    """Lever angle, roller lift and blade opening (with the mouth) vs carrier angle, events marked."""
+    phi = np.linspace(0.0, 2 * np.pi, 1441)
+    lam, lift, beta = design.profile.follower_at_carrier(phi, design.cam_angle)
+    figure, (top, bottom) = _figure(8.0, 6.0, nrows=2, sharex=True)
+    degrees = np.degrees(phi)
+    top.plot(degrees, lift, color="tab:blue", label="roller lift (mm)")
+    top.plot(degrees, np.degrees(lam), color="tab:purple", ls="--", label="lever angle (deg)")
+    top.set_ylabel("follower")
+    bottom.plot(degrees, np.degrees(beta), color="tab:red", label="blade opening (deg)")
+    mouth = design.linkage.mouth_width(beta)
+    twin = bottom.twinx()
+    twin.plot(degrees, mouth, color="tab:orange", ls=":", label="mouth (mm)")
+    twin.axhline(design.linkage.required_mouth, color="tab:orange", lw=0.8, alpha=0.6)
+    twin.set_ylabel("mouth (mm)")
+    bottom.set_ylabel("blade opening (deg)")
+    bottom.set_xlabel("carrier angle (deg, 0 = catching)")
+    for name, angle in design.timing.events.items():
+        if name == "catching":
+            continue
+        for axes in (top, bottom):
+            axes.axvline(np.degrees(angle), color=_EVENT_STYLE.get(name, "0.5"), lw=0.8, ls="-.")
+        top.annotate(name.replace("_", " "), (np.degrees(angle), 1.0), xycoords=("data", "axes fraction"),
+                     rotation=90, va="top", ha="right", fontsize=7)
+    for start, end in (design.timing.opening, design.timing.closing):
+        top.axvspan(np.degrees(start), np.degrees(end), color="0.85", zorder=0)
+    top.legend(loc="upper left", fontsize=8)
+    bottom.legend(loc="upper left", fontsize=8)
+    twin.legend(loc="upper right", fontsize=8)
+    top.set_title("Duckbill cam: closed through catching and transport, open from the lowest "
+                  "point until the seedling is cleared", fontsize=9)
+    for axes in (top, bottom):
+        axes.grid(alpha=0.3)
+        axes.set_xlim(0, 360)
+    return _png(figure)
+
+
+def contour(design, points: int) -> bytes:
+    """The cam contour with its pitch curve, base circle and the checks' worst places."""
+    profile, check = design.profile, design.check
+    figure, ax = _figure(6.5, 6.5)
+    working = profile.working_profile(points)
+    pitch = profile.pitch_curve(points)
+    ax.fill(working[:, 0], working[:, 1], color="0.8", label="cam (working profile)")
+    ax.plot(*np.vstack([working, working[:1]]).T, color="k", lw=0.8)
+    ax.plot(*np.vstack([pitch, pitch[:1]]).T, color="tab:blue", ls="--", lw=0.8,
+            label="pitch curve (roller centre)")
+    import matplotlib.patches as patches
+
+    for theta, colour, label in ((check.pressure_angle_at, "tab:red", "largest pressure angle"),
+                                 (check.pitch_radius_at, "tab:purple", "smallest convex radius")):
+        centre = profile.pitch_point(theta)[0][0]
+        ax.add_patch(patches.Circle(centre, profile.roller_radius, fill=False, color=colour,
+                                    label=label))
+    ax.plot([0], [0], "k+", ms=12)
+    ax.set_aspect("equal")
+    ax.set_title(f"Cam: pressure angle max {np.degrees(check.pressure_angle_max):.1f} deg, "
+                 f"smallest convex pitch radius {check.pitch_radius_convex_min:.2f} mm "
+                 f"(roller {profile.roller_radius:g} mm)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.3)
+    return _png(figure)
+
+
+def cam_figures(design, points: int) -> dict:
+    return {"cam-follower.png": follower_motion(design), "cam-contour.png": contour(design, points)}

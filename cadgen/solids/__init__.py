@@ -1,0 +1,81 @@
+"""A generic solids toolkit: validated outlines, extrusions, closed housings, mass, export.
+
+Modules
+-------
+outline
+    Outline validation (finite, enough points, no repeats, area, simple) and the
+    shapes housings are made of: :func:`circle`, :func:`hull_of_circles`,
+    :func:`offset_outline`, :func:`segments_for`. numpy, scipy and shapely only.
+extrude
+    The manifold3d/trimesh adapter: :func:`extrude` (validates first),
+    :func:`to_trimesh` (refuses empty, open, mis-wound, inside-out meshes),
+    :func:`from_trimesh`.
+shell
+    :func:`closed_shell`, a hollow housing round gears' swept discs, and
+    :func:`encloses`, the check that a part lies inside its cavity.
+mass
+    :func:`mass_properties`: volume, area, mass, centre of mass, inertia (mm, kg).
+export
+    Deterministic bytes: :func:`stl_bytes`, :func:`assembly_bytes` (GLB, 3MF),
+    :func:`load_volume` for round trips, atomic :func:`write_stl` / :func:`write_assembly`.
+errors
+    :class:`SolidError` and friends (the project's :class:`~kinematics.errors.MechanismError` family).
+tolerances
+    The named tolerances and limits used above.
+
+Nothing heavy is imported here: manifold3d, trimesh and shapely load on first use.
+"""
+
+from cadgen.solids.errors import ExportFormatError, SolidError, SolidInputError
+from cadgen.solids.export import (
+    AssemblyFormat,
+    assembly_bytes,
+    load_volume,
+    stl_bytes,
+    write_assembly,
+    write_stl,
+)
+from cadgen.solids.extrude import cross_section, extrude, from_trimesh, to_trimesh
+from cadgen.solids.mass import mass_properties
+from cadgen.solids.outline import (
+    circle,
+    holes_problems,
+    hull_of_circles,
+    offset_outline,
+    outline_problems,
+    segments_for,
+    signed_area,
+    validate_holes,
+    validate_outline,
+)
+from cadgen.solids.shell import Housing, closed_shell, encloses, shell_outlines
+
+__all__ = [
+    "AssemblyFormat",
+    "ExportFormatError",
+    "Housing",
+    "SolidError",
+    "SolidInputError",
+    "assembly_bytes",
+    "circle",
+    "closed_shell",
+    "cross_section",
+    "encloses",
+    "extrude",
+    "from_trimesh",
+    "holes_problems",
+    "hull_of_circles",
+    "load_volume",
+    "mass_properties",
+    "offset_outline",
+    "outline_problems",
+    "segments_for",
+    "shell_outlines",
+    "signed_area",
+    "stl_bytes",
+    "to_trimesh",
+    "validate_holes",
+    "validate_outline",
+    "write_assembly",
+    "write_stl",
+]
