@@ -201,19 +201,21 @@ class _Outcome:
 
 def run_analysis(params, output_root: Path | str | None = Path("outputs"),
                  steps_per_revolution: int | None = None, plots: bool = True,
-                 gears: bool = True, cam: bool = True) -> AnalysisResult:
+                 gears: bool = True, cam: bool = True, solids: bool = True) -> AnalysisResult:
     """Analyse one validated design; write ``<output_root>/<name>/`` atomically.
 
     With ``output_root=None`` nothing is written (the report is still returned).
     ``gears`` generates, checks and meshes every gear of the trains and writes
     their DXF files under ``gears/``; ``cam`` designs the planting mechanism's
-    duckbill cam and writes ``cam.dxf`` (when the roller can follow the contour).
+    duckbill cam and writes ``cam.dxf`` (when the roller can follow the contour);
+    ``solids`` builds every part (manifold3d), checks that the housings enclose
+    their gears, and writes ``solids/*.stl`` and the assembly file.
     """
     draw = plots and output_root is not None
     if params.mechanism == "pricking":
-        outcome = _pricking(params, draw, gears)
+        outcome = _pricking(params, draw, gears, solids)
     else:
-        outcome = _planting(params, steps_per_revolution, draw, gears, cam)
+        outcome = _planting(params, steps_per_revolution, draw, gears, cam, solids)
     report = outcome.report
     if output_root is None:
         return AnalysisResult(params.name, report, None)
@@ -260,7 +262,7 @@ def _with_train(outcome: _Outcome, train, chord_tolerance: float) -> _Outcome:
     return outcome
 
 
-def _planting(params, steps_per_revolution, plots, gears=True, cam=True) -> _Outcome:
+def _planting(params, steps_per_revolution, plots, gears=True, cam=True, solids=True) -> _Outcome:
     from .design import build_mechanism, evaluate
     from .gear_trains import pair_figures, planting_train
 
@@ -277,6 +279,15 @@ def _planting(params, steps_per_revolution, plots, gears=True, cam=True) -> _Out
 
         with _stage(timings, "cam"):
             cam_design = design_cam(params, mechanism, evaluation.events)
+    solid_parts = None
+    if solids:
+        from .solids.planting import planting_assembly
+
+        with _stage(timings, "solids"):
+            assembly, housings, _ = planting_assembly(params, mechanism, train, cam_design,
+                                                      evaluation.events.soil_level)
+            solid_parts = _solids_outcome(params, assembly,
+                                          {"gearbox1": housings[0], "gearbox2": housings[1]})
     figures = {}
     if plots:
         with _stage(timings, "plots"):
@@ -294,7 +305,28 @@ def _planting(params, steps_per_revolution, plots, gears=True, cam=True) -> _Out
         outcome.report["cam"] = _cam_section(cam_design, params)
         if cam_design.cuttable:
             outcome.writers.append(lambda staging: _write_cam(staging, cam_design, params))
+    _with_solids(outcome, solid_parts, timings)
     return _with_train(outcome, train, params.gears.chord_tolerance)
+
+
+def _solids_outcome(params, assembly, housings):
+    from .solids.stage import SolidsOutcome, enclosure_checks
+
+    settings = params.solids
+    return SolidsOutcome(assembly, housings, enclosure_checks(assembly, housings),
+                         settings.assembly_carrier_angle_rad, settings.density_kg_m3,
+                         settings.assembly_format)
+
+
+def _with_solids(outcome: _Outcome, solid_parts, timings) -> None:
+    """Add the solids' report section (mass properties, enclosure) and their file writer."""
+    if solid_parts is None:
+        return
+    from .solids.stage import solids_report, write_solids
+
+    with _stage(timings, "solids_report"):
+        outcome.report["solids"] = solids_report(solid_parts)
+    outcome.writers.append(lambda staging: write_solids(solid_parts, staging))
 
 
 def _cam_section(design, params) -> dict:
@@ -316,7 +348,7 @@ def _write_cam(staging, design, params):
     return ["cam.dxf"]
 
 
-def _pricking(params, plots, gears=True) -> _Outcome:
+def _pricking(params, plots, gears=True, solids=True) -> _Outcome:
     from .design import pricking_design, pricking_field
     from .gear_trains import pair_figures, pricking_train
     from .pricking_report import pricking_report
@@ -327,6 +359,13 @@ def _pricking(params, plots, gears=True) -> _Outcome:
     with _stage(timings, "field"):
         field_motion = pricking_field(params, design)
     train = _gear_train(timings, gears, lambda: pricking_train(params, design))
+    solid_parts = None
+    if solids:
+        from .solids.pricking import pricking_assembly
+
+        with _stage(timings, "solids"):
+            assembly, housings = pricking_assembly(params, design, train, field_motion)
+            solid_parts = _solids_outcome(params, assembly, housings)
     figures = {}
     if plots:
         with _stage(timings, "plots"):
@@ -336,7 +375,9 @@ def _pricking(params, plots, gears=True) -> _Outcome:
             if train is not None and train.stages:
                 figures.update(pair_figures(train))
     report = pricking_report(params, design, field_motion, timings, _versions(), input_hash(params))
-    return _with_train(_Outcome(report, figures), train, params.gears.chord_tolerance)
+    outcome = _Outcome(report, figures)
+    _with_solids(outcome, solid_parts, timings)
+    return _with_train(outcome, train, params.gears.chord_tolerance)
 
 
 def _jsonable(value):

@@ -52,6 +52,8 @@ __all__ = [
     "write_gear_dxf",
     "write_train_sheet",
     "write_cam_dxf",
+    "thinned_outline",
+    "thinned_contour",
 ]
 
 #: Layer name -> AutoCAD colour index (7 = white/black, 1 red, 3 green, 4 cyan, 2 yellow).
@@ -354,6 +356,25 @@ def _thin_gear(profile, outline: np.ndarray, pitch: np.ndarray, tolerance: float
 
 
 # --------------------------------------------------------------------------- public API
+
+
+def thinned_outline(profile, chord_tolerance: float = 0.005) -> np.ndarray:
+    """The outline a gear's DXF file holds: thinned to ``chord_tolerance``, simple, bore kept clear.
+
+    The solids are extruded from it, so the STL and the DXF describe the same cut part.
+    """
+    return thinned_contour(profile.outline, chord_tolerance, centre=profile.centre,
+                           bore_radius=profile.bore_radius)
+
+
+def thinned_contour(points, chord_tolerance: float = 0.005, *, centre=(0.0, 0.0),
+                    bore_radius: float = 0.0) -> np.ndarray:
+    """A dense closed contour thinned as the DXF writers thin it (a cam's, a gear's)."""
+    tolerance = _check_tolerance(chord_tolerance)
+    centre = np.asarray(centre, dtype=float)
+    keep_clear = (centre, float(bore_radius)) if bore_radius > 0 else None
+    return _thin_ring(_closed_points(points), tolerance, keep_clear=keep_clear)[0]
+
 
 
 def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float = 0.005) -> DxfSummary:

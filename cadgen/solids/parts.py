@@ -1,0 +1,110 @@
+"""Parts of an assembly: a solid in its body's frame, and the rigid poses that move the bodies.
+
+A :class:`Part` is a manifold3d solid in the frame of the rigid body it rides on
+(``carrier1``, ``gearbox2``, ``planter``, ...), placed there by ``local`` (a 4x4
+transform that may depend on the pose, e.g. a gear turning on its shaft). A
+mechanism's :class:`Assembly` knows each body's world transform at any carrier
+angle and each part's local placement, so the same part meshes serve the STL
+files, the assembly file at a chosen angle, and (later) the collision sweep.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["Part", "Assembly", "planar_transform", "gear_solid"]
+
+
+def planar_transform(angle: float = 0.0, offset=(0.0, 0.0), z: float = 0.0) -> np.ndarray:
+    """4x4 homogeneous transform: turn by ``angle`` (rad) about z, then move by ``(x, y, z)``."""
+    c, s = np.cos(angle), np.sin(angle)
+    transform = np.eye(4)
+    transform[:2, :2] = [[c, -s], [s, c]]
+    transform[:2, 3] = offset
+    transform[2, 3] = z
+    return transform
+
+
+@dataclass
+class Part:
+    """One solid of an assembly.
+
+    Attributes
+    ----------
+    name : str
+        File stem of its STL (unique in the assembly).
+    kind : str
+        ``"gear"``, ``"housing"``, ``"cam"``, ``"planter"``, ``"blade"``,
+        ``"rocker"``, ``"needle"``, ``"ground"``.
+    body : str
+        The rigid body it rides on (a key of the assembly's body poses).
+    solid : manifold3d.Manifold
+        In the part's own frame (a gear: its axis at the origin).
+    local : callable
+        ``phi -> (4, 4)`` placement of the part in its body's frame at carrier angle phi.
+    instances : tuple
+        ``(instance name, body, phase offset)`` of each placed copy (both arms
+        use one part); empty for a single instance on ``body`` at phase 0.
+    outline : (n, 2) float, optional
+        The section a prism part was extruded from (gears), for exact 2D checks.
+    """
+
+    name: str
+    kind: str
+    body: str
+    solid: object
+    local: Callable = field(default=lambda phi: np.eye(4))
+    instances: tuple = ()     # ((instance name, body, phase offset rad), ...); empty: one at body
+    outline: object = None    # (n, 2) section of a z-prism part (gears), for exact 2D checks
+    _mesh: object = field(default=None, repr=False)
+
+    @property
+    def mesh(self):
+        """The trimesh of the solid (converted once; watertight and positive, or SolidError)."""
+        if self._mesh is None:
+            from .extrude import to_trimesh
+
+            self._mesh = to_trimesh(self.solid, self.name)
+        return self._mesh
+
+
+@dataclass
+class Assembly:
+    """Parts and the poses of the bodies they ride on.
+
+    ``body_pose(body, phi)`` gives the 4x4 world transform of a body at carrier
+    angle ``phi``; a part instance with phase offset ``p`` rides on its body at
+    ``phi + p`` (the second planting arm is the first at ``phi + pi``).
+    """
+
+    parts: list
+    body_pose: Callable
+
+    def placements(self, phi: float):
+        """``[(instance name, part, 4x4 world transform)]`` at carrier angle ``phi`` (rad)."""
+        out = []
+        for part in self.parts:
+            instances = part.instances or ((part.name, part.body, 0.0),)
+            for name, body, phase in instances:
+                pose = self.body_pose(body, phi + phase) @ part.local(phi + phase)
+                out.append((name, part, pose))
+        return out
+
+
+def gear_solid(profile, face_width: float, segments: int, path: str, chord_tolerance: float):
+    """A gear extruded from its cut outline, with its bore, from z = 0 (its own frame): (solid, outline).
+
+    The outline is the one the gear's DXF holds (thinned to ``chord_tolerance``), so
+    the STL and the cutting file describe the same part.
+    """
+    from ..export_dxf import thinned_outline
+    from .extrude import extrude
+    from .outline import circle
+
+    holes = [circle(profile.bore_radius, segments, profile.centre)] if profile.bore_radius > 0 else []
+    outline = thinned_outline(profile, chord_tolerance)
+    return extrude(outline, face_width, holes=holes, path=path,
+                   outline_path=f"gear {profile.name!r} outline"), outline

@@ -1,0 +1,339 @@
+"""The planting mechanism's solids: gears, gearbox 1, gearbox 2, cam, planter shell, blades, ground.
+
+Frames. The mechanism plane is z = 0 of the world (x forward, y up), z towards
+the arms. Bodies and their poses at carrier angle ``phi`` (arm 2 is arm 1 at
+``phi + pi``):
+
+``carrier1``
+    Gearbox 1 and train 1's gears: turns by ``-phi`` about O (clockwise).
+``gearbox2``
+    Origin at C, x along C->D->E (``gamma = phic + phi``): the housing, the four
+    gears of the second train, and the cam (fixed to gearbox 2, coaxial with E).
+``planter``
+    Origin at E, x along ``u(Psi)``: the arm plate E-P1, the duckbill tube and the
+    two blades (opened by the cam's law at the pose).
+``ground``
+    Fixed: the soil (flat or a ridge along the travel), its top at the soil level.
+
+Axial stack (z, from the machine outwards): gearbox 1 (train 1's gears), gearbox
+2 (layer 1: the non-circular pair; layer 2: the 1:1 circular pair), the cam plate,
+the planter's arm plate, and the duckbill tube beside it. Every gap is
+``housing.axial_gap``. The housings' outlines are the hull of the same envelope
+discs the kinematic clearance checks use (largest tip + clearance + wall), so
+both checks see one housing.
+
+Not modelled: train 1's second gear set (ratio -1/2, no sizes in the spec), the
+cam lever, push rod and blade links (their motion is in the cam report), shafts
+and bearings.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .parts import Assembly, Part, gear_solid, planar_transform
+
+__all__ = ["PlantingLayout", "planting_assembly"]
+
+
+@dataclass(frozen=True)
+class PlantingLayout:
+    """Axial positions (mm) of the planting mechanism's layers, and its gear face widths."""
+
+    face_nc: float          # non-circular gears
+    face_c: float           # circular gears
+    gap: float
+    box1_floor: float       # cavity floors
+    box1_height: float
+    box1_wall: float
+    box2_floor: float
+    box2_height: float
+    box2_wall: float
+    cam_bottom: float
+    cam_thickness: float
+    arm_bottom: float
+    arm_thickness: float
+    tube_axis: float        # z of the duckbill tube's axis
+    tube_radius: float      # outer
+
+    @property
+    def layer1(self) -> float:
+        """Bottom of gearbox 2's first gear layer (the non-circular pair)."""
+        return self.box2_floor + self.gap
+
+    @property
+    def layer2(self) -> float:
+        """Bottom of gearbox 2's second gear layer (the 1:1 pair)."""
+        return self.layer1 + self.face_nc + self.gap
+
+    @property
+    def z_range(self) -> tuple:
+        return (self.box1_floor - self.box1_wall, self.tube_axis + self.tube_radius)
+
+
+def layout_of(params, mechanism, shells, cam_design) -> PlantingLayout:
+    gap = params.housing.axial_gap
+    face_nc = params.gears.face_width_for(mechanism.module(params.pitch_curve.teeth))
+    face_c = params.gears.face_width_for(shells["gearbox1"].module)
+    w1, w2 = shells["gearbox1"].wall, shells["gearbox2"].wall
+    box1_height = face_c + 2 * gap
+    box2_floor = box1_height + w1 + gap + w2
+    box2_height = face_nc + face_c + 3 * gap
+    cam_bottom = box2_floor + box2_height + w2 + gap
+    cam_thickness = params.cam.thickness if cam_design is not None else 0.0
+    arm_bottom = cam_bottom + cam_thickness + gap
+    arm_thickness = params.planter.arm_thickness
+    tube_radius = _tube_radius(params, cam_design)
+    # the tube stands beside the arm plate, overlapping it by one shell wall so they join
+    tube_axis = arm_bottom + arm_thickness + tube_radius - params.planter.shell_wall
+    return PlantingLayout(face_nc, face_c, gap, 0.0, box1_height, w1, box2_floor, box2_height, w2,
+                          cam_bottom, cam_thickness, arm_bottom, arm_thickness, tube_axis,
+                          tube_radius)
+
+
+def _tube_radius(params, cam_design) -> float:
+    """Outer radius of the duckbill tube: round the blade hinges plus the shell wall."""
+    if cam_design is not None:
+        hinge = cam_design.linkage.hinge_offset
+    else:
+        hinge = params.cam.duckbill.blade_length * math.sin(params.cam.closed_half_angle_rad)
+    return hinge + params.planter.shell_wall
+
+
+# ------------------------------------------------------------------ bodies
+def body_poses(mechanism, layout):
+    """``(body, phi) -> 4x4`` world transform of each body at carrier angle ``phi``."""
+
+    def pose(body, phi):
+        if body in ("carrier1", "ground"):
+            return planar_transform(-phi if body == "carrier1" else 0.0)
+        phi_array = np.array([phi])
+        if body == "gearbox2":
+            centre = mechanism.positions(phi_array, points=("C",))["C"][0]
+            return planar_transform(mechanism.phic + phi, centre)
+        if body == "planter":
+            hub = mechanism.positions(phi_array, points=("E",))["E"][0]
+            return planar_transform(float(mechanism.attitude(phi_array)[0]), hub)
+        raise KeyError(f"unknown body {body!r}")
+
+    return pose
+
+
+# ------------------------------------------------------------------ parts
+def _gear_parts(params, mechanism, train, layout, segments):
+    """Every gear of both trains, in its body, turning with the carrier angle."""
+    from ..gear_trains import _placements
+
+    n = mechanism.n
+    F = mechanism.intermediate_rotation
+    R = mechanism.R
+    # each gear's rotation relative to its body, from the catching pose (rad)
+    relative = {
+        "central": lambda phi: -phi,
+        "intermediate": lambda phi: float(F(phi)),
+        "gear D": lambda phi: float(F(phi)),
+        "planet gear E": lambda phi: -float(F(phi)),
+        "sun": lambda phi: -(n - 1) * phi,
+        "idler 1": lambda phi: (n - 1) * phi * R / (R * mechanism.i12),
+        "idler 2": lambda phi: -(n - 1) * phi * R / (R * mechanism.i13),
+        "train-1 planet": lambda phi: (n - 1) * phi,
+    }
+    in_box2 = {"central": layout.layer1, "intermediate": layout.layer1,
+               "gear D": layout.layer2, "planet gear E": layout.layer2}
+    start = body_poses(mechanism, layout)
+    parts = []
+    for profile, angle, centre in _placements(train):
+        body = "gearbox2" if profile.name in in_box2 else "carrier1"
+        circular = profile.name not in ("central", "intermediate")
+        face = layout.face_c if circular else layout.face_nc
+        z = in_box2.get(profile.name, layout.box1_floor + layout.gap)
+        # the gear's placement in its body at the catching pose (both from arm 1 at phi = 0)
+        world = planar_transform(angle, centre, z)
+        local0 = np.linalg.solve(start(body, 0.0), world)
+        turn = relative[profile.name]
+
+        def local(phi, local0=local0, turn=turn):
+            return local0 @ planar_transform(turn(phi))
+
+        solid, outline = gear_solid(profile, face, segments, path="gears.face_width",
+                           chord_tolerance=params.gears.chord_tolerance)
+        instances = (((profile.file_stem + "-arm1", "gearbox2", 0.0),
+                      (profile.file_stem + "-arm2", "gearbox2", math.pi))
+                     if body == "gearbox2" else
+                     ((profile.file_stem + "-side1", "carrier1", 0.0),)
+                     if profile.name == "sun" else
+                     ((profile.file_stem + "-side1", "carrier1", 0.0),
+                      (profile.file_stem + "-side2", "carrier1:mirrored", 0.0)))
+        parts.append(Part(profile.file_stem, "gear", body, solid, local, instances, outline))
+    return parts
+
+
+def _housing_parts(params, mechanism, circles, shells, layout, segments):
+    from .shell import closed_shell
+
+    a, r = mechanism.centre_distance, mechanism.r
+    radius = {(c.gearbox, c.point): c.radius for c in circles}
+    box2 = shells["gearbox2"]
+    discs2 = [(0.0, 0.0, radius["gearbox2", "C"] - box2.allowance),
+              (a, 0.0, radius["gearbox2", "D"] - box2.allowance),
+              (a + 2 * r, 0.0, radius["gearbox2", "E"] - box2.allowance)]
+    box1 = shells["gearbox1"]
+    line = np.array([math.cos(mechanism.phi0), math.sin(mechanism.phi0)])
+    carrier = mechanism.carrier_radii
+    discs1 = [(0.0, 0.0, radius["gearbox1", "O"] - box1.allowance)]
+    for sign in (1.0, -1.0):   # both arms hang on carrier 1
+        for axis in ("A", "B", "C"):
+            x, y = sign * carrier[axis] * line
+            discs1.append((x, y, radius["gearbox1", axis] - box1.allowance))
+    housing2 = closed_shell(discs2, height=layout.box2_height, clearance=box2.clearance,
+                            wall=box2.wall, segments=segments, path="housing",
+                            z_cavity_bottom=layout.box2_floor, min_wall=_min_wall())
+    housing1 = closed_shell(discs1, height=layout.box1_height, clearance=box1.clearance,
+                            wall=box1.wall, segments=segments, path="housing",
+                            z_cavity_bottom=layout.box1_floor, min_wall=_min_wall())
+    return (Part("gearbox1", "housing", "carrier1", housing1.solid),
+            Part("gearbox2", "housing", "gearbox2", housing2.solid,
+                 instances=(("gearbox2-arm1", "gearbox2", 0.0),
+                            ("gearbox2-arm2", "gearbox2", math.pi)))), (housing1, housing2)
+
+
+def _min_wall():
+    from ..params.solids import MIN_WALL
+
+    return MIN_WALL
+
+
+def _cam_part(params, mechanism, cam_design, layout, segments):
+    from ..export_dxf import thinned_contour
+    from .extrude import extrude
+    from .outline import circle
+
+    points = params.cam.profile_points
+    bore = params.cam.bore_diameter / 2
+    holes = [circle(bore, segments)] if bore > 0 else []
+    # the contour cam.dxf holds, so the STL and the cutting file describe the same cam
+    contour = thinned_contour(cam_design.profile.working_profile(points),
+                              params.gears.chord_tolerance, bore_radius=bore)
+    solid = extrude(contour, params.cam.thickness, holes=holes,
+                    z0=layout.cam_bottom, path="cam.thickness", outline_path="cam contour")
+    # the cam's frame is the planter's at the catching pose; it is fixed to gearbox 2 at E
+    a, r = mechanism.centre_distance, mechanism.r
+    attitude = float(mechanism.attitude(np.array([0.0]))[0])
+    local0 = planar_transform(attitude - mechanism.phic, (a + 2 * r, 0.0))
+    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0,
+                (("cam-arm1", "gearbox2", 0.0), ("cam-arm2", "gearbox2", math.pi)))
+
+
+def _planter_parts(params, cam_design, layout, segments):
+    """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades."""
+    import manifold3d as m3d
+
+    from .extrude import extrude
+    from .outline import hull_of_circles
+
+    planter = params.planter
+    L1, L2, wall = planter.L1, planter.L2, planter.shell_wall
+    half = planter.arm_width / 2
+    plate = extrude(hull_of_circles([(0.0, 0.0, half), (-L1, 0.0, half)], segments),
+                    layout.arm_thickness, z0=layout.arm_bottom, path="planter.arm_thickness",
+                    outline_path="planter arm plate")
+    if cam_design is not None:
+        linkage = cam_design.linkage
+        lb, d0, hinge = linkage.blade_length, linkage.closed_half_angle, linkage.hinge
+    else:
+        lb, d0 = params.cam.duckbill.blade_length, params.cam.closed_half_angle_rad
+        hinge = np.array([-L1 + lb * math.sin(d0), -L2 + lb * math.cos(d0)])
+    e, hinge_y = float(hinge[0] + L1), float(hinge[1])
+    outer = layout.tube_radius
+    # the tube: from the blade hinges up to P1, along the planter's y axis
+    tube_length = -hinge_y
+    tube = (m3d.Manifold.cylinder(tube_length, outer, outer, segments)
+            - m3d.Manifold.cylinder(tube_length, outer - wall, outer - wall, segments))
+    tube = _stand_up(tube).translate((-L1, hinge_y, layout.tube_axis))
+    shell = plate + tube
+    # the duckbill: a cone shell from the hinge circle (radius e) down to the tip N, split in halves
+    height = lb * math.cos(d0)
+    cone = m3d.Manifold.cylinder(height, 0.0, e + wall, segments)
+    inner = m3d.Manifold.cylinder(height, 0.0, e, segments).translate((0.0, 0.0, wall / math.sin(d0)))
+    cone = _stand_up(cone - inner).translate((-L1, -L2, layout.tube_axis))
+    right = cone ^ m3d.Manifold.cube((outer * 4, L2 * 2, outer * 4)).translate(
+        (-L1, -2 * L2, layout.tube_axis - 2 * outer))
+    left = cone - m3d.Manifold.cube((outer * 4, L2 * 2, outer * 4)).translate(
+        (-L1, -2 * L2, layout.tube_axis - 2 * outer))
+    opening = cam_design.profile if cam_design is not None else None
+
+    def blade_local(sign, pivot):
+        def local(phi):
+            if opening is None:
+                return np.eye(4)
+            lam = opening.program(np.array([float(cam_design.cam_angle(phi))]))[0]
+            beta = float(cam_design.linkage.opening_of_lever(lam)[0])
+            # a blade turns about its hinge axis (along z): the right one counter-clockwise
+            turn = planar_transform(sign * beta)
+            return (planar_transform(0.0, pivot) @ turn @ planar_transform(0.0, -pivot))
+        return local
+
+    hinge_right = np.array([-L1 + e, hinge_y])
+    hinge_left = np.array([-L1 - e, hinge_y])
+    arms = lambda stem: ((f"{stem}-arm1", "planter", 0.0), (f"{stem}-arm2", "planter", math.pi))
+    return [Part("planter-shell", "planter", "planter", shell, instances=arms("planter-shell")),
+            Part("blade-right", "blade", "planter", right, blade_local(1.0, hinge_right),
+                 arms("blade-right")),
+            Part("blade-left", "blade", "planter", left, blade_local(-1.0, hinge_left),
+                 arms("blade-left"))]
+
+
+def _stand_up(solid):
+    """Turn a solid built along +z so that its axis runs along +y (rotation about x by -90 deg)."""
+    return solid.rotate((-90.0, 0.0, 0.0))
+
+
+def mechanism_extent(mechanism, circles, steps: int = 360) -> tuple:
+    """x range (mm) the mechanism sweeps over a revolution: points of both arms plus envelopes."""
+    phi = np.linspace(0.0, 2 * np.pi, steps, endpoint=False)
+    reach = max(c.radius for c in circles)
+    xs = []
+    for arm in (0, 1):
+        positions = mechanism.positions(phi, arm=arm)
+        xs += [p[:, 0] for p in positions.values()]
+    xs = np.concatenate(xs)
+    return float(xs.min() - reach), float(xs.max() + reach)
+
+
+def planting_assembly(params, mechanism, train, cam_design, soil_level: float) -> tuple:
+    """Every solid of the planting mechanism and the poses of their bodies.
+
+    Returns ``(assembly, housings, layout)``; ``housings`` are the
+    :class:`~cadgen.solids.shell.Housing` records of gearbox 1 and gearbox 2 (for
+    the enclosure checks).
+    """
+    from ..housings import housing_circles, planting_shells
+    from .ground import ground_part
+
+    segments = params.solids.segments_per_circle
+    shells = planting_shells(params, mechanism)
+    circles = housing_circles(params, mechanism)
+    layout = layout_of(params, mechanism, shells, cam_design)
+    parts = []
+    housing_parts, housings = _housing_parts(params, mechanism, circles, shells, layout, segments)
+    parts += housing_parts
+    if train is not None and train.stages:
+        parts += _gear_parts(params, mechanism, train, layout, segments)
+    if cam_design is not None and cam_design.cuttable:
+        parts.append(_cam_part(params, mechanism, cam_design, layout, segments))
+    parts += _planter_parts(params, cam_design, layout, segments)
+    x_range = mechanism_extent(mechanism, circles)
+    z_range = layout.z_range
+    parts.append(ground_part(params.ground, soil_level, x_range, z_range,
+                             ridge_centre=layout.tube_axis, segments=segments))
+    poses = body_poses(mechanism, layout)
+
+    def pose(body, phi):
+        if body == "carrier1:mirrored":   # train 1's gears of the second arm: half a turn about O
+            return poses("carrier1", phi) @ planar_transform(math.pi)
+        return poses(body, phi)
+
+    return Assembly(parts, pose), housings, layout

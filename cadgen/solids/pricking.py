@@ -1,0 +1,178 @@
+"""The pricking mechanism's solids: gears, gear case, rocker, needle, and the inclined ground.
+
+Frames: the mechanism plane is z = 0 (x forward, y up in the plane). The carrier
+angle of a pose is the carrier's turn since the outer dead centre (the gears'
+start position), in the carrier's sense. Bodies:
+
+``case``
+    The gear case (a closed shell round the sun, the intermediate pair and the
+    planet) turning with the carrier about O; origin O, at the start pose equal to
+    the world.
+``planet``
+    Origin B, x along the rocker: the rocker (l1, from B) and the needle (l2,
+    perpendicular to it at the rocker's end, its tip at D).
+``ground``
+    The soil slab with its surface at the mechanism plane's surface line
+    (``y_min + depth / cos(theta)``) for the file's first inclination, tilted by
+    theta about the travel direction, as the inclined mechanism plane sees it.
+
+Each gear rides on the case and turns by the pair's rotation at the pose; the sun
+is fixed in the world (it turns backwards relative to the case).
+
+Axial stack: the case's cavity (stage 1 layer, then stage 2 layer), the rocker
+outside the case's wall, and the needle beside the rocker.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .parts import Assembly, Part, gear_solid, planar_transform
+
+__all__ = ["pricking_assembly"]
+
+
+def _pose_parameters(design, angle):
+    """Curve parameter ``v`` and carrier angle ``phi1`` after the carrier turned by ``angle``."""
+    motion = design.motion
+    start = float(motion.phi1(0.0))
+    turns, rest = divmod(float(angle), 2 * math.pi)
+    phi1 = start + motion.sense * rest
+    v = float(motion.invert(np.array([phi1]))[0])
+    return v, phi1 + motion.sense * 2 * math.pi * turns
+
+
+def pricking_assembly(params, design, train, field):
+    """Every solid of the pricking mechanism and the poses of their bodies.
+
+    ``field`` is the list of :class:`~kinematics.pricking_field.InclinationResult`;
+    the ground uses the first. Returns ``(assembly, {"gear-case": Housing})``.
+    """
+    from kinematics.pricking_field import needle_geometry
+
+    from .ground import ground_part
+    from .shell import closed_shell
+
+    segments = params.solids.segments_per_circle
+    link = design.linkage
+    centre = np.asarray(link.centre, dtype=float)
+    motion = design.motion
+    needle = needle_geometry(design)
+    housing = params.housing
+    gap = housing.axial_gap
+    start = float(motion.phi1(0.0))
+    poses = {}
+
+    def pose_of(angle):
+        # the inverse kinematics is a bisection: solve each pose once for every part
+        if angle not in poses:
+            poses[angle] = _pose_parameters(design, angle)
+        return poses[angle]
+
+    def carrier_pose(angle):
+        v, phi1 = pose_of(angle)
+        return planar_transform(phi1 - start, centre) @ planar_transform(0.0, -centre)
+
+    def planet_pose(angle):
+        v, phi1 = pose_of(angle)
+        B = centre + 2 * link.a * np.array([math.cos(phi1), math.sin(phi1)])
+        tip = motion.tip(np.array([v]))[0]
+        axis = float(needle.axis_angle(motion.phi2(np.array([v]))[0]))
+        root = tip - needle.needle * np.array([math.cos(axis), math.sin(axis)])
+        rocker = math.atan2(root[1] - B[1], root[0] - B[0])
+        return planar_transform(rocker, B)
+
+    def body_pose(body, angle):
+        if body == "case":
+            return carrier_pose(angle)
+        if body == "planet":
+            return planet_pose(angle)
+        return np.eye(4)
+
+    module = max(design.modules)
+    clearance, wall = housing.clearance_for(module), housing.wall_for(module)
+    faces = [params.gears.face_width_for(m) for m in design.modules]
+    layers = [gap, 2 * gap + faces[0]]
+    parts, discs = [], {}
+    if train is not None and train.stages:
+        from ..gear_trains import _placements
+
+        stage_of = {}
+        for index, stage in enumerate(train.stages):
+            for name in stage.generated.pair.names:
+                stage_of.setdefault(name, index)
+        for profile, _, at_start in _placements(train):
+            index = stage_of[profile.name]
+            stage = train.stages[index]
+            which = stage.generated.pair.names.index(profile.name)
+            offset = np.asarray(at_start) - centre
+            radius = float(np.max(np.linalg.norm(profile.outline - np.asarray(profile.centre),
+                                                 axis=1)))
+            key = round(float(np.hypot(*offset)), 6)
+            discs[key] = max(discs.get(key, 0.0), radius)
+
+            def local(angle, stage=stage, which=which, at=centre + offset, z=layers[index]):
+                # in the case's frame the line of centres stays where it was at the start, so
+                # a gear sits where it started, turned by the pair's rotation at the pose
+                v, _ = pose_of(angle)
+                turn = float(stage.generated.pair.rotations(np.array([v]))[which][0])
+                return planar_transform(stage.placement[0] + turn, at, z)
+
+            solid, outline = gear_solid(profile, faces[index], segments, path="gears.face_width",
+                                        chord_tolerance=params.gears.chord_tolerance)
+            parts.append(Part(profile.file_stem, "gear", "case", solid, local, outline=outline))
+    # the case: round the discs the gears sweep at O, A and B (2a from O)
+    line = np.array([math.cos(start), math.sin(start)])
+    if not discs:   # no gears generated: a coarse envelope, each gear within the centre distance
+        discs = {0.0: link.a, round(link.a, 6): link.a, round(2 * link.a, 6): link.a}
+    circles = [(*(centre + d * line), r) for d, r in sorted(discs.items())]
+    height = faces[0] + faces[1] + 3 * gap
+    case = closed_shell(circles, height=height, clearance=clearance, wall=wall, segments=segments,
+                        path="housing", z_cavity_bottom=0.0, min_wall=_min_wall())
+    parts.insert(0, Part("gear-case", "housing", "case", case.solid))
+    parts += _rocker_and_needle(params, link, needle, z0=height + wall + gap, segments=segments)
+    surface = field[0].surface_level
+    theta = math.radians(field[0].inclination_deg)
+    reach = 2 * link.a + link.l + max(r for _, _, r in circles)
+    x_range = (float(centre[0] - reach), float(centre[0] + reach))
+    ground = ground_part(params.ground, surface * math.cos(theta), x_range,
+                         (-wall, height + 2 * wall + gap + 2 * params.linkage.needle_diameter),
+                         ridge_centre=0.0, segments=segments)
+    tilt = np.eye(4)
+    c, s = math.cos(theta), math.sin(theta)
+    # vertical-frame (X, Y, Z) -> mechanism frame: y = Y cos + Z sin, z = -Y sin + Z cos
+    tilt[1:3, 1:3] = [[c, s], [-s, c]]
+    ground.local = lambda angle, tilt=tilt: tilt
+    parts.append(ground)
+    return Assembly(parts, body_pose), {"gear-case": case}
+
+
+def _min_wall():
+    from ..params.solids import MIN_WALL
+
+    return MIN_WALL
+
+
+def _rocker_and_needle(params, link, needle, *, z0, segments):
+    """The rocker bar from B along +x (l1) and the needle from its end, perpendicular, to D."""
+    import manifold3d as m3d
+
+    from .extrude import extrude
+    from .outline import hull_of_circles
+
+    linkage = params.linkage
+    half = linkage.rocker_width / 2
+    rocker = extrude(hull_of_circles([(0.0, 0.0, half), (link.rocker, 0.0, half)], segments),
+                     linkage.rocker_thickness, z0=z0, path="linkage.rocker_thickness",
+                     outline_path="rocker outline")
+    radius = linkage.needle_diameter / 2
+    cone = min(3 * linkage.needle_diameter, 0.5 * link.needle)
+    shaft = m3d.Manifold.cylinder(link.needle - cone, radius, radius, segments)
+    point = m3d.Manifold.cylinder(cone, radius, 0.0, segments).translate((0, 0, link.needle - cone))
+    # built along +z from the root; turn +z onto the needle's direction in the plane (+-y),
+    # and put its axis beside the rocker so the two overlap and join
+    body = (shaft + point).rotate((-90.0 * needle.side, 0.0, 0.0))
+    body = body.translate((link.rocker, 0.0, z0 + linkage.rocker_thickness / 2))
+    return [Part("rocker", "rocker", "planet", rocker), Part("needle", "needle", "planet", body)]

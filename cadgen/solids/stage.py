@@ -1,0 +1,112 @@
+"""The solids stage of a build: parts, enclosure checks, mass properties, STL and assembly files.
+
+Output under ``solids/``: one binary STL per distinct part in its own frame (a
+part used twice, e.g. by both planting arms, is written once), and the assembly
+(GLB or 3MF) with every instance placed at the chosen carrier angle. The report
+section lists each part's mass properties at the file's density and, per
+housing, whether its gears stay inside the cavity over a revolution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["SolidsOutcome", "solids_report", "write_solids", "enclosure_checks"]
+
+@dataclass
+class SolidsOutcome:
+    assembly: object
+    housings: dict           # housing part name -> Housing (cadgen.solids.shell)
+    enclosure: list          # one dict per housing
+    carrier_angle: float     # rad, the assembly file's pose
+    density: float
+    file_type: str
+
+
+def enclosure_checks(assembly, housings: dict) -> list:
+    """Whether every gear stays inside its housing's cavity at every pose, with the margin.
+
+    A gear turns about a fixed axis of its housing, so over a revolution it sweeps
+    the disc of its largest outline radius about that axis: the gear stays inside
+    at every pose exactly when that disc lies in the cavity outline and the gear's
+    faces lie between the cavity's floor and roof. Reports the smallest radial
+    margin (mm; negative: the gear cuts into the wall) and the gear it belongs to.
+    """
+    import shapely
+
+    results = []
+    for housing_name, housing in housings.items():
+        cavity = shapely.Polygon(housing.cavity_outline)
+        z_low, z_high = housing.z_cavity_bottom, housing.z_cavity_bottom + housing.cavity_height
+        body = next(p.body for p in assembly.parts if p.name == housing_name)
+        worst, worst_gear, axial_ok = np.inf, None, True
+        for part in assembly.parts:
+            if part.kind != "gear" or part.body != body:
+                continue
+            bottom, top = part.mesh.bounds[:, 2]
+            local = part.local(0.0)
+            reach = float(np.max(np.linalg.norm(part.outline, axis=1)))
+            axial_ok &= bool(z_low <= bottom + local[2, 3] + 1e-9
+                             and top + local[2, 3] <= z_high + 1e-9)
+            axes = [local[:2, 3]]
+            if any(b.endswith(":mirrored") for _, b, _ in part.instances):
+                axes.append(-local[:2, 3])   # the same gear on the carrier's other side
+            for axis in axes:
+                point = shapely.Point(axis)
+                distance = cavity.exterior.distance(point)
+                margin = (distance if cavity.contains(point) else -distance) - reach
+                if margin < worst:
+                    worst, worst_gear = margin, part.name
+        results.append({"housing": housing_name, "gears_enclosed": bool(worst >= 0 and axial_ok),
+                        "smallest_margin_mm": float(worst) if worst_gear else None,
+                        "nearest_gear": worst_gear, "axial_fit": bool(axial_ok)})
+    return results
+
+
+def solids_report(outcome: SolidsOutcome) -> dict:
+    """Mass properties per part, the enclosure checks and the assembly's pose (report.json)."""
+    from .mass import mass_properties
+
+    parts = []
+    total = 0.0
+    for part in outcome.assembly.parts:
+        instances = part.instances or ((part.name, part.body, 0.0),)
+        if part.kind == "ground":
+            continue
+        props = mass_properties(part.mesh, outcome.density)
+        total += props["mass_kg"] * len(instances)
+        parts.append({
+            "part": part.name, "kind": part.kind, "instances": len(instances),
+            "file": f"solids/{part.name}.stl", "triangles": int(len(part.mesh.faces)),
+            "volume_mm3": props["volume_mm3"], "area_mm2": props["area_mm2"],
+            "mass_kg": props["mass_kg"], "centre_of_mass_mm": props["centre_of_mass_mm"].tolist(),
+            "inertia_kg_mm2": props["inertia_kg_mm2"].tolist(),
+            "watertight": bool(part.mesh.is_watertight),
+            "winding_consistent": bool(part.mesh.is_winding_consistent),
+        })
+    return {"density_kg_m3": outcome.density, "parts": parts, "total_mass_kg": total,
+            "assembly": {"file": f"solids/assembly.{outcome.file_type}",
+                         "carrier_angle_deg": float(np.degrees(outcome.carrier_angle))},
+            "enclosure": outcome.enclosure,
+            "frames": "each STL in its part's own frame (gears: axis at the origin, faces at "
+                      "z = 0 and z = face width); the assembly places every instance"}
+
+
+def write_solids(outcome: SolidsOutcome, staging) -> list:
+    """Write ``solids/<part>.stl`` and ``solids/assembly.<glb|3mf>``; return the relative paths."""
+    from .export import assembly_bytes, stl_bytes
+
+    folder = staging / "solids"
+    folder.mkdir()
+    written = []
+    for part in outcome.assembly.parts:
+        (folder / f"{part.name}.stl").write_bytes(stl_bytes(part.mesh))
+        written.append(f"solids/{part.name}.stl")
+    placed = [(name, part.mesh, pose) for name, part, pose
+              in outcome.assembly.placements(outcome.carrier_angle)]
+    (folder / f"assembly.{outcome.file_type}").write_bytes(
+        assembly_bytes(placed, outcome.file_type))
+    written.append(f"solids/assembly.{outcome.file_type}")
+    return written
