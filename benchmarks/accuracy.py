@@ -16,6 +16,9 @@ The closure quadrature (periodic trapezoid rule) is measured per node count
 against the converged centre distance, with the 1-degree rectangle rule as the
 paper's peer.
 
+Solids: the mesh resolution (segments per circle, flank points per tooth) against
+closed forms and converged references, see :mod:`benchmarks.mesh_resolution`.
+
 Pricking mechanism: the inverse solve is exact along the curve (piecewise
 Chebyshev); the resolution knob is the uniform carrier grid on which the pitch
 curves are tabulated for manufacture. Its accuracy is measured by rebuilding
@@ -160,6 +163,17 @@ def pricking_table():
     return rows
 
 
+def solids_lines():
+    """The mesh-resolution tables of the solids (see benchmarks/mesh_resolution.py)."""
+    from cadgen.design import build_mechanism
+    from cadgen.params import load_params
+
+    from .mesh_resolution import markdown
+
+    params = load_params(Path(__file__).resolve().parents[1] / "params" / "xin2024-planter.toml")
+    return markdown(params, build_mechanism(params))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", type=Path, default=Path("docs/accuracy.md"))
@@ -219,6 +233,7 @@ def main(argv=None):
     for name, degree, grid, deviation, closure, seconds in pricking:
         lines.append(f"| {name} | {degree} | {grid} | {deviation:.1e} | {closure:.1e} | "
                      f"{seconds * 1e3:.0f} |")
+    lines += solids_lines()
     lines.append("")
     args.output.parent.mkdir(parents=True, exist_ok=True)
     args.output.write_text("\n".join(lines))

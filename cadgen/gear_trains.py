@@ -23,7 +23,7 @@ from .housings import circular_module, planting_circular_radii
 from .meshing import meshing_check, relieve_interference
 from .teeth import ToothSystem
 
-__all__ = ["GearStage", "GearTrain", "planting_train", "pricking_train", "circular_module",
+__all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "pricking_train", "circular_module",
            "write_train_files", "train_report", "pair_figures"]
 
 
@@ -94,9 +94,8 @@ def _carry(generated):
     return generated.phases[1], (generated.profiles[1], generated.checks[1], generated.spaces[1])
 
 
-def planting_train(params, mechanism) -> GearTrain:
-    """The planting mechanism's gears at the catching position (phi = 0)."""
-    cutting = params.gears
+def planting_pair(mechanism) -> PitchPair:
+    """Gearbox 2's non-circular pair as contact functions of the central gear's turn."""
     closure = mechanism.closure
     curve, law, a = mechanism.pitch_curve, closure.law, closure.centre_distance
 
@@ -110,8 +109,15 @@ def planting_train(params, mechanism) -> GearTrain:
         w, _ = law.ratio(t)
         return a - r, -dr, np.pi - law.integral(t), -w
 
+    return PitchPair(("central", "intermediate"), a, 2 * np.pi, central, intermediate)
+
+
+def planting_train(params, mechanism) -> GearTrain:
+    """The planting mechanism's gears at the catching position (phi = 0)."""
+    cutting = params.gears
+    a = mechanism.centre_distance
     teeth = params.pitch_curve.teeth
-    pair = PitchPair(("central", "intermediate"), a, 2 * np.pi, central, intermediate)
+    pair = planting_pair(mechanism)
     box = mechanism.phic
     C = np.asarray(mechanism.positions(np.array([0.0]), points=("C",))["C"][0])
     module_nc = mechanism.module(teeth)   # the spec: module from perimeter and z

@@ -7,7 +7,6 @@ earlier output of the code under test.
 
 from __future__ import annotations
 
-import importlib.util
 import math
 
 import numpy as np
@@ -485,14 +484,11 @@ def test_glb_round_trip_and_determinism(parts):
     assert moved == pytest.approx(parts[2][2], abs=1e-12)
 
 
-def test_three_mf_is_deterministic_or_clearly_unavailable(parts):
-    if importlib.util.find_spec("lxml") and importlib.util.find_spec("networkx"):
-        data = assembly_bytes(parts, "3mf")
-        assert assembly_bytes(parts, "3mf") == data
-        assert load_volume(data, "3mf") == pytest.approx(sum(m.volume for _, m, _ in parts), rel=1e-9)
-    else:
-        with pytest.raises(ExportFormatError, match="lxml and networkx"):
-            assembly_bytes(parts, "3mf")
+def test_three_mf_is_deterministic_and_round_trips(parts):
+    # lxml and networkx are core dependencies (pyproject.toml), so 3MF is always there
+    data = assembly_bytes(parts, "3mf")
+    assert assembly_bytes(parts, "3mf") == data
+    assert load_volume(data, "3mf") == pytest.approx(sum(m.volume for _, m, _ in parts), rel=1e-9)
 
 
 def test_assembly_checks_its_input(parts):

@@ -1,0 +1,266 @@
+"""The mechanisms' solids: closed parts, gear volumes, housings enclosing their gears, files.
+
+Independent sources: the shoelace area of each gear's cut outline times its face
+width; manifold3d booleans of placed gears against their housing (a second
+method beside the report's disc-in-cavity check); the cam law's mouth width
+against the blades' placed vertices; the kinematic envelope circles against the
+solid housing's lowest point; volumes read back from the written files.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from cadgen.analyze import _solids_outcome
+from cadgen.cam_design import design_cam
+from cadgen.design import build_mechanism, evaluate, pricking_design, pricking_field
+from cadgen.gear_trains import planting_train, pricking_train
+from cadgen.params import ParameterError, load_params, validate_text
+from cadgen.params.planting import Gearbox2Envelope
+from cadgen.solids import encloses, load_volume
+from cadgen.solids.export import assembly_bytes, stl_bytes
+from cadgen.solids.outline import signed_area
+from cadgen.solids.parts import gear_solid
+from cadgen.solids.planting import planting_assembly
+from cadgen.solids.pricking import pricking_assembly
+from cadgen.solids.stage import solids_report
+from kinematics.errors import DesignError
+
+from helpers import REFERENCE, reference_text
+
+KERNEL_B = REFERENCE.parent / "kernel-b.toml"
+
+
+@pytest.fixture(scope="module")
+def planting():
+    params = load_params(REFERENCE)
+    mechanism = build_mechanism(params)
+    evaluation = evaluate(params, mechanism, steps=720)
+    cam = design_cam(params, mechanism, evaluation.events)
+    train = planting_train(params, mechanism)
+    assembly, housings, layout = planting_assembly(params, mechanism, train, cam,
+                                                   evaluation.events.soil_level)
+    return params, mechanism, evaluation, cam, train, assembly, housings, layout
+
+
+@pytest.fixture(scope="module")
+def pricking():
+    params = load_params(KERNEL_B)
+    design = pricking_design(params)
+    field = pricking_field(params, design)
+    train = pricking_train(params, design)
+    assembly, housings = pricking_assembly(params, design, train, field)
+    return params, design, train, assembly, housings
+
+
+def _to_manifold(part, transform):
+    return part.solid.transform(transform[:3, :])
+
+
+@pytest.mark.parametrize("which", ["planting", "pricking"])
+def test_every_part_is_a_closed_positive_volume(which, request):
+    assembly = request.getfixturevalue(which)[-3 if which == "planting" else -2]
+    kinds = set()
+    for part in assembly.parts:
+        mesh = part.mesh
+        assert mesh.is_watertight and mesh.is_winding_consistent, part.name
+        assert mesh.volume > 0, part.name
+        kinds.add(part.kind)
+    expected = ({"gear", "housing", "cam", "planter", "blade", "ground"} if which == "planting"
+                else {"gear", "housing", "rocker", "needle", "ground"})
+    assert kinds == expected
+
+
+@pytest.mark.parametrize("which", ["planting", "pricking"])
+def test_gear_volume_is_outline_area_times_face_width(which, request):
+    fixture = request.getfixturevalue(which)
+    params, assembly = fixture[0], fixture[-3 if which == "planting" else -2]
+    gears = [p for p in assembly.parts if p.kind == "gear"]
+    assert gears
+    for part in gears:
+        bottom, top = part.mesh.bounds[:, 2]
+        face = top - bottom
+        area = signed_area(part.outline)
+        bore = params.gears.bore_diameter / 2
+        if bore > 0:
+            n = params.solids.segments_per_circle
+            area -= n / 2 * bore**2 * math.sin(2 * math.pi / n)
+        assert part.mesh.volume == pytest.approx(area * face, rel=1e-9), part.name
+
+
+def test_gears_with_a_bore_keep_it(planting):
+    profile = dataclasses.replace(planting[4].gears[0][0], bore_radius=5.0)
+    solid, outline = gear_solid(profile, 10.0, 64, "gears.face_width", 0.005)
+    hole = 64 / 2 * 5.0**2 * math.sin(2 * math.pi / 64)   # the bore is an inscribed 64-gon
+    assert solid.volume() == pytest.approx((signed_area(outline) - hole) * 10.0, rel=1e-9)
+
+
+def test_planting_housings_enclose_their_gears_checked_with_booleans(planting):
+    *_, assembly, housings, _ = planting
+    box = {"gearbox1": housings[0], "gearbox2": housings[1]}
+    for phi in (0.0, 1.234, 4.0):
+        for part in assembly.parts:
+            if part.kind != "gear":
+                continue
+            housing = box["gearbox2" if part.body == "gearbox2" else "gearbox1"]
+            inside, outside = encloses(housing, _to_manifold(part, part.local(phi)))
+            assert inside, (part.name, phi, outside)
+    report = _solids_outcome(planting[0], assembly, box).enclosure
+    assert all(row["gears_enclosed"] for row in report)
+    assert {row["nearest_gear"] for row in report} <= {p.name for p in assembly.parts}
+
+
+def test_a_housing_too_small_for_its_gears_is_reported(planting):
+    """Explicit envelope radii 8 mm short at C: the central gear cuts into gearbox 2's wall."""
+    params, mechanism, evaluation, cam, train, *_ = planting
+    from cadgen.housings import housing_circles
+
+    radius_c = next(c.radius for c in housing_circles(params, mechanism)
+                    if (c.gearbox, c.point) == ("gearbox2", "C"))
+    small = params.model_copy(update={"housing": params.housing.model_copy(update={
+        "gearbox2": Gearbox2Envelope(C=radius_c - 8.0)})})
+    assembly, housings, _ = planting_assembly(small, mechanism, train, cam,
+                                              evaluation.events.soil_level)
+    rows = {r["housing"]: r for r in _solids_outcome(
+        small, assembly, {"gearbox1": housings[0], "gearbox2": housings[1]}).enclosure}
+    assert not rows["gearbox2"]["gears_enclosed"] and rows["gearbox2"]["nearest_gear"] == "central"
+    # the cavity still holds the hull's tangents towards D, so somewhat less than 8 mm is lost
+    assert -8.0 - 0.05 < rows["gearbox2"]["smallest_margin_mm"] < 0.0
+    central = next(p for p in assembly.parts if p.name == "central")
+    # and the booleans agree: at some pose the central gear pokes into the wall
+    assert any(not encloses(housings[1], _to_manifold(central, central.local(phi)))[0]
+               for phi in np.linspace(0, 2 * np.pi, 12, endpoint=False))
+
+
+def test_pricking_case_encloses_its_gears(pricking):
+    *_, assembly, housings = pricking
+    case = housings["gear-case"]
+    for angle in (0.0, 2.0, 4.5):
+        for part in (p for p in assembly.parts if p.kind == "gear"):
+            inside, outside = encloses(case, _to_manifold(part, part.local(angle)))
+            assert inside, (part.name, angle, outside)
+
+
+def test_pricking_needle_tip_follows_the_designed_loop(pricking):
+    params, design, _, assembly, _ = pricking
+    needle = next(p for p in assembly.parts if p.name == "needle")
+    for angle in (0.0, 1.0, 3.0, 5.5):
+        pose = assembly.body_pose("planet", angle)
+        vertices = needle.mesh.vertices @ pose[:3, :3].T + pose[:3, 3]
+        # the needle's point is its one vertex farthest from B; it must sit on the loop
+        far = vertices[np.argmax(np.linalg.norm(vertices[:, :2] - pose[:2, 3], axis=1))]
+        start = float(design.motion.phi1(0.0))
+        v = design.motion.invert(np.array([start + design.motion.sense * angle]))
+        assert np.linalg.norm(far[:2] - design.motion.tip(v)[0]) < 1e-6
+
+
+def test_blades_open_to_the_mouth_the_cam_gives(planting):
+    params, mechanism, evaluation, cam, *_ = planting
+    assembly = planting[5]
+    phi = 0.5 * (cam.timing.opening[1] + cam.timing.closing[0])   # held open
+    tips = []
+    for name, part, pose in assembly.placements(phi):
+        if part.kind == "blade" and name.endswith("arm1"):
+            world = part.mesh.vertices @ pose[:3, :3].T + pose[:3, 3]
+            # the blade tip: its vertex nearest the closed tip N, taken in the planter frame
+            planter = np.linalg.inv(assembly.body_pose("planter", phi))
+            local = world @ planter[:3, :3].T + planter[:3, 3]
+            tips.append(local[np.argmin(local[:, 1])])
+    width = abs(tips[0][0] - tips[1][0])
+    assert width == pytest.approx(cam.linkage.mouth_width(cam.linkage.opening_angle), abs=1e-6)
+    assert width >= params.cam.pot_diameter
+
+
+def test_solid_housing_matches_the_kinematic_ground_clearance(planting):
+    """The housing's outline is the hull of the kinematic envelope circles (circumscribed
+    polygons: at most r (1/cos(pi/n) - 1) farther out)."""
+    params, mechanism, evaluation, *_ = planting
+    assembly = planting[5]
+    phi = math.radians(evaluation.extras["ground_clearance_at_deg"])
+    lowest = np.inf
+    for name, part, pose in assembly.placements(phi):
+        if part.kind == "housing":
+            world = part.mesh.vertices @ pose[:3, :3].T + pose[:3, 3]
+            lowest = min(lowest, world[:, 1].min())
+    solid_clearance = lowest - evaluation.events.soil_level
+    kinematic = next(m.value for m in evaluation.metrics if m.key == "ground_clearance")
+    n = params.solids.segments_per_circle
+    bound = max(c.radius for c in evaluation.housing_circles) * (1 / math.cos(math.pi / n) - 1)
+    assert kinematic - bound - 1e-9 <= solid_clearance <= kinematic + 1e-9
+
+
+def test_stl_and_assembly_round_trip_with_the_same_volume(planting, tmp_path):
+    assembly = planting[5]
+    for part in assembly.parts[:4] + [p for p in assembly.parts if p.kind == "blade"]:
+        data = stl_bytes(part.mesh)
+        assert load_volume(data, "stl") == pytest.approx(part.mesh.volume, rel=1e-6)
+    placed = [(name, part.mesh, pose) for name, part, pose in assembly.placements(0.7)]
+    total = sum(part.mesh.volume for _, part, _ in assembly.placements(0.7))
+    for kind, rtol in (("glb", 1e-6), ("3mf", 1e-9)):
+        data = assembly_bytes(placed, kind)
+        assert load_volume(data, kind) == pytest.approx(total, rel=rtol)
+
+
+def test_mass_properties_against_closed_forms(planting):
+    params = planting[0]
+    report = solids_report(_solids_outcome(params, planting[5], {
+        "gearbox1": planting[6][0], "gearbox2": planting[6][1]}))
+    rows = {row["part"]: row for row in report["parts"]}
+    density = params.solids.density_kg_m3 * 1e-9
+    for name in ("sun", "idler-1", "central"):
+        row = rows[name]
+        assert row["mass_kg"] == pytest.approx(row["volume_mm3"] * density, rel=1e-12)
+    # a circular gear is symmetric about its axis: centre of mass on it, mid-face
+    sun = rows["sun"]
+    face = params.gears.face_width_for(1.8)
+    np.testing.assert_allclose(sun["centre_of_mass_mm"], [0.0, 0.0, face / 2], atol=1e-6)
+    inertia = np.array(sun["inertia_kg_mm2"])
+    assert inertia[0, 0] == pytest.approx(inertia[1, 1], rel=1e-6)   # axisymmetric
+    # between the solid discs of the root and the tip radius: m r^2 / 2
+    tip = 36.0 + 1.8
+    assert 0.5 * sun["mass_kg"] * 30.0**2 < inertia[2, 2] < 0.5 * sun["mass_kg"] * tip**2
+    assert report["total_mass_kg"] == pytest.approx(
+        sum(r["mass_kg"] * r["instances"] for r in report["parts"]), rel=1e-12)
+
+
+@pytest.mark.parametrize("changes, path, code", [
+    (dict(face_width="0.0"), "gears.face_width", "out_of_range"),
+    (dict(wall="1.0"), "housing.wall", "wall_too_thin"),
+])
+def test_bad_solid_parameters_name_the_field(changes, path, code):
+    text = _with_keys(changes)
+    with pytest.raises(ParameterError) as caught:
+        validate_text(text)
+    assert (path, code) in {(p.path, p.code) for p in caught.value.problems}
+
+
+def _with_keys(changes):
+    """The reference file with keys added to [housing] or [gears] (added if missing)."""
+    text = reference_text()
+    for key, value in changes.items():
+        table = "[housing]" if key == "wall" else "[gears]"
+        if table not in text:
+            text += f"\n{table}\n"
+        text = text.replace(table + "\n", f"{table}\n{key} = {value}\n", 1)
+    return text
+
+
+def test_a_self_intersecting_gear_outline_is_refused_before_extrusion(planting):
+    profile = planting[4].gears[0][0]
+    outline = profile.outline.copy()
+    k = len(outline) // 3
+    outline[[k, k + 40]] = outline[[k + 40, k]]   # two far points swapped: the ring crosses itself
+    with pytest.raises(DesignError) as caught:
+        gear_solid(dataclasses.replace(profile, outline=outline), 10.0, 64, "gears.face_width",
+                   chord_tolerance=1e-9)
+    assert caught.value.problems[0].code == "self_intersecting_outline"
+    assert "central" in caught.value.problems[0].path
+
+
+def test_assembly_is_deterministic(planting):
+    assembly = planting[5]
+    placed = [(name, part.mesh, pose) for name, part, pose in assembly.placements(0.3)]
+    again = [(name, mesh.copy(), pose.copy()) for name, mesh, pose in placed]
+    assert assembly_bytes(placed, "glb") == assembly_bytes(again, "glb")
