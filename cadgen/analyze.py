@@ -33,6 +33,10 @@ class AnalysisResult:
             text = format_metrics_table(self.report)
         if "gear_train" in self.report:
             text += "\n\n" + format_gear_table(self.report["gear_train"])
+        if "cam" in self.report:
+            text += "\n\n" + format_cam(self.report["cam"])
+        if "solids" in self.report:
+            text += "\n\n" + format_solids(self.report["solids"])
         return text + (
             f"\nwrote {len(self.files)} files to {self.output_dir}" if self.output_dir else "")
 
@@ -157,6 +161,40 @@ def format_metrics_table(report: dict) -> str:
     d = report["derived"]
     lines.append(f"centre distance a = {d['centre_distance_a_mm']:.6f} mm, "
                  f"module {d['module_mm']:.4f} mm, ratio {d['ratio_min']:.4f}..{d['ratio_max']:.4f}")
+    return "\n".join(lines)
+
+
+def format_cam(cam: dict) -> str:
+    """Plain-text summary of the duckbill cam and its checks."""
+    events = cam["carrier_angle_deg"]
+    lines = [f"cam: opening {cam['opening_angle_deg']:.2f} deg (mouth {cam['mouth_mm']:.1f} mm for "
+             f"{cam['required_mouth_mm']:.1f} mm), push-rod stroke {cam['push_rod_stroke_mm']:.2f} "
+             f"mm, roller lift {cam['roller_lift_mm']:.2f} mm",
+             f"     opens {events['opening'][0]:.1f}..{events['opening'][1]:.1f} deg, closes "
+             f"{events['closing'][0]:.1f}..{events['closing'][1]:.1f} deg (lowest point "
+             f"{events['lowest']:.1f}, exit {events['exit']:.1f}, seedling cleared "
+             f"{events['seedling_cleared']:.1f})",
+             f"     pressure angle max {cam['pressure_angle_max_deg']:.2f} deg, smallest convex "
+             f"pitch radius {cam['pitch_radius_convex_min_mm']:.2f} mm for a "
+             f"{cam['roller_radius_mm']:g}-mm roller"]
+    for problem in cam["problems"]:
+        lines.append(f"     FAIL [{problem['code']}] {problem['message']}")
+    return "\n".join(lines)
+
+
+def format_solids(solids: dict) -> str:
+    """Plain-text summary of the solids: parts, mass, enclosure."""
+    parts = solids["parts"]
+    instances = sum(p["instances"] for p in parts)
+    lines = [f"solids: {len(parts)} parts ({instances} placed), total mass "
+             f"{solids['total_mass_kg']:.2f} kg at {solids['density_kg_m3']:g} kg/m3, assembly at "
+             f"carrier angle {solids['assembly']['carrier_angle_deg']:g} deg"]
+    for row in solids["enclosure"]:
+        margin = row["smallest_margin_mm"]
+        state = ("encloses its gears" if row["gears_enclosed"] else "DOES NOT enclose its gears")
+        detail = f" (smallest margin {margin:.2f} mm, {row['nearest_gear']})" if margin is not None \
+            else " (no gears generated)"
+        lines.append(f"     {row['housing']} {state}{detail}")
     return "\n".join(lines)
 
 
@@ -300,6 +338,15 @@ def _planting(params, steps_per_revolution, plots, gears=True, cam=True, solids=
                 from .plots_cam import cam_figures
 
                 figures.update(cam_figures(cam_design, params.cam.profile_points))
+            if solid_parts is not None:
+                from .plots_solids import assembly_view
+
+                angle = solid_parts.carrier_angle
+                tip = mechanism.motion(np.linspace(0, 2 * np.pi, 721), "N").position
+                figures["assembly.png"] = assembly_view(
+                    solid_parts.assembly, angle, paths=[(tip, "tip path N (relative)")],
+                    soil_level=evaluation.events.soil_level,
+                    title=f"Solids at carrier angle {np.degrees(angle):g} deg (front view)")
     outcome = _Outcome(report_dict(params, mechanism, evaluation, timings), figures)
     if cam_design is not None:
         outcome.report["cam"] = _cam_section(cam_design, params)
@@ -374,6 +421,16 @@ def _pricking(params, plots, gears=True, solids=True) -> _Outcome:
             figures = pricking_figures(params, design, field_motion)
             if train is not None and train.stages:
                 figures.update(pair_figures(train))
+            if solid_parts is not None:
+                from .plots_solids import assembly_view
+
+                angle = solid_parts.carrier_angle
+                loop = design.motion.tip(np.linspace(0, design.motion.period, 721))
+                figures["assembly.png"] = assembly_view(
+                    solid_parts.assembly, angle, paths=[(loop, "needle-tip loop")],
+                    soil_level=field_motion[0].surface_level,
+                    title=f"Solids {np.degrees(angle):g} deg of carrier turn after the outer dead "
+                          "centre (front view, in the mechanism plane)")
     report = pricking_report(params, design, field_motion, timings, _versions(), input_hash(params))
     outcome = _Outcome(report, figures)
     _with_solids(outcome, solid_parts, timings)

@@ -19,15 +19,23 @@ def test_writes_report_and_plots(params, tmp_path):
     folder = tmp_path / "xin2024-planter"
     plots = sorted(p.name for p in (folder / "plots").iterdir())
     assert [p for p in plots if not p.startswith("gears-")] == [
-        "absolute_paths.png", "attitude.png", "cam-contour.png", "cam-follower.png",
+        "absolute_paths.png", "assembly.png", "attitude.png", "cam-contour.png", "cam-follower.png",
         "pitch_curves.png", "relative_path.png", "tip_velocity.png"]
     assert len([p for p in plots if p.startswith("gears-")]) == 5   # one picture per pair
     dxf = sorted(p.name for p in (folder / "gears").iterdir())
     assert dxf == ["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf", "intermediate.dxf",
                    "planet-gear-E.dxf", "sun.dxf", "train-1-planet.dxf", "train.dxf"]
     assert (folder / "cam.dxf").is_file()
+    solids = sorted(p.name for p in (folder / "solids").iterdir())
+    assert solids == sorted(["assembly.glb", "blade-left.stl", "blade-right.stl", "cam.stl",
+                             "central.stl", "gear-D.stl", "gearbox1.stl", "gearbox2.stl",
+                             "ground.stl", "idler-1.stl", "idler-2.stl", "intermediate.stl",
+                             "planet-gear-E.stl", "planter-shell.stl", "sun.stl",
+                             "train-1-planet.stl"])
     report = json.loads((folder / "report.json").read_text())
     assert report["cam"]["cuttable"] and report["cam"]["problems"] == []
+    assert all(row["gears_enclosed"] for row in report["solids"]["enclosure"])
+    assert {p["file"] for p in report["solids"]["parts"]} <= {f"solids/{n}" for n in solids}
     assert report["derived"]["centre_distance_a_mm"] == pytest.approx(59.944, abs=1e-3)
     assert report["passed"] is True
     assert {m["key"] for m in report["metrics"]} >= {
@@ -70,7 +78,7 @@ def test_pricking_report_says_where_the_gears_are_concave(tmp_path):
     result = run_analysis(params, output_root=tmp_path)
     folder = tmp_path / "kernel-a"
     assert sorted(p.name for p in (folder / "plots").iterdir()) == [
-        "field_paths.png", "loop.png", "pitch_curves.png", "ratio.png"]
+        "assembly.png", "field_paths.png", "loop.png", "pitch_curves.png", "ratio.png"]
     # kernel-a's gears are too concave for any cutter: said, not drawn
     assert {f["code"] for f in json.loads((folder / "report.json").read_text())
             ["gear_train"]["failures"]} == {"gear_not_cuttable"}
@@ -82,3 +90,16 @@ def test_pricking_report_says_where_the_gears_are_concave(tmp_path):
     assert len(report["field"]["per_inclination"]) == 3
     text = result.summary_text()
     assert "concave" in text and "near Q" in text
+
+
+def test_same_input_same_files(params, tmp_path):
+    """Every written file but report.json (it holds the stage timings) is byte-identical."""
+    for root in ("first", "second"):
+        run_analysis(params, output_root=tmp_path / root, plots=False)
+    first, second = tmp_path / "first" / "xin2024-planter", tmp_path / "second" / "xin2024-planter"
+    files = sorted(p.relative_to(first) for p in first.rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(second) for p in second.rglob("*") if p.is_file())
+    assert {f.suffix for f in files} == {".dxf", ".stl", ".glb", ".json"}
+    for name in files:
+        if name.name != "report.json":
+            assert (first / name).read_bytes() == (second / name).read_bytes(), name

@@ -268,3 +268,24 @@ def test_impossible_cam_files_name_the_field(changes, path, code):
         validate_text(edited(**changes))
     found = {(p.path, p.code) for p in caught.value.problems}
     assert any(p == path and (code is None or c == code) for p, c in found), found
+
+
+def test_cam_dxf_is_one_closed_cutting_path_within_the_chord_tolerance(paper, tmp_path):
+    import ezdxf
+
+    from cadgen.export_dxf import write_cam_dxf
+
+    profile = paper[3].profile
+    contour, pitch = profile.working_profile(3600), profile.pitch_curve(3600)
+    summary = write_cam_dxf(tmp_path / "cam.dxf", contour, pitch, bore_radius=6.0,
+                            chord_tolerance=0.005)
+    doc = ezdxf.readfile(tmp_path / "cam.dxf")
+    assert not doc.audit().has_errors and doc.units == 4   # millimetres
+    outlines = doc.modelspace().query('LWPOLYLINE[layer=="OUTLINE"]')
+    assert len(outlines) == 1 and outlines[0].closed
+    written = shapely.LinearRing([p[:2] for p in outlines[0].get_points()])
+    assert written.is_simple
+    # every point of the dense contour lies within the chord tolerance of the written path
+    assert max(written.distance(shapely.Point(p)) for p in contour[::7]) <= 0.005 + 1e-12
+    assert len(doc.modelspace().query('CIRCLE[layer=="BORE"]')) == 1
+    assert summary.outline_points_written < len(contour)

@@ -264,3 +264,25 @@ def test_assembly_is_deterministic(planting):
     placed = [(name, part.mesh, pose) for name, part, pose in assembly.placements(0.3)]
     again = [(name, mesh.copy(), pose.copy()) for name, mesh, pose in placed]
     assert assembly_bytes(placed, "glb") == assembly_bytes(again, "glb")
+
+
+def test_ridge_ground_has_the_profile_it_was_given():
+    from cadgen.params.solids import GroundParameters
+    from cadgen.solids.ground import ground_part
+
+    ground = GroundParameters(profile="ridge", ridge_top_width=300.0, ridge_height=150.0,
+                              ridge_side_slope_deg=45.0, furrow_width=200.0, thickness=100.0,
+                              margin=0.0)
+    part = ground_part(ground, -500.0, (-400.0, 600.0), (0.0, 100.0), ridge_centre=50.0,
+                       segments=32)
+    mesh = part.mesh
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    # the section: slab under the furrows (width W x 100) plus the trapezoidal ridge
+    (x0, y0, z0), (x1, y1, z1) = mesh.bounds
+    width = z1 - z0
+    ridge = 0.5 * (300.0 + 300.0 + 2 * 150.0) * 150.0     # 45 deg sides: 150 mm runs
+    assert (x1 - x0, y1) == pytest.approx((1000.0, -500.0))
+    assert mesh.volume == pytest.approx((width * 100.0 + ridge) * 1000.0, rel=1e-12)
+    # the ridge top is centred on z = 50 and 300 mm wide at the soil level
+    top = mesh.vertices[np.isclose(mesh.vertices[:, 1], -500.0)]
+    assert (top[:, 2].min(), top[:, 2].max()) == pytest.approx((-100.0, 200.0))

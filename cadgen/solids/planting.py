@@ -224,7 +224,7 @@ def _cam_part(params, mechanism, cam_design, layout, segments):
     attitude = float(mechanism.attitude(np.array([0.0]))[0])
     local0 = planar_transform(attitude - mechanism.phic, (a + 2 * r, 0.0))
     return Part("cam", "cam", "gearbox2", solid, lambda phi: local0,
-                (("cam-arm1", "gearbox2", 0.0), ("cam-arm2", "gearbox2", math.pi)))
+                (("cam-arm1", "gearbox2", 0.0), ("cam-arm2", "gearbox2", math.pi)), contour)
 
 
 def _planter_parts(params, cam_design, layout, segments):
