@@ -191,10 +191,13 @@ def format_solids(solids: dict) -> str:
              f"carrier angle {solids['assembly']['carrier_angle_deg']:g} deg"]
     for row in solids["enclosure"]:
         margin = row["smallest_margin_mm"]
+        if margin is None:
+            lines.append(f"     {row['housing']}: no gears were cut, so its size is a coarse "
+                         "estimate (each gear within the centre distance)")
+            continue
         state = ("encloses its gears" if row["gears_enclosed"] else "DOES NOT enclose its gears")
-        detail = f" (smallest margin {margin:.2f} mm, {row['nearest_gear']})" if margin is not None \
-            else " (no gears generated)"
-        lines.append(f"     {row['housing']} {state}{detail}")
+        lines.append(f"     {row['housing']} {state} (smallest margin {margin:.2f} mm, "
+                     f"{row['nearest_gear']})")
     return "\n".join(lines)
 
 
