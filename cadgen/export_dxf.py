@@ -1,4 +1,4 @@
-"""DXF export of generated gears: one cutting file per gear and an assembled train sheet.
+"""DXF export of generated gears (one cutting file per gear, an assembled train sheet) and cams.
 
 Each gear file holds, in millimetres and on layers of their own:
 
@@ -12,7 +12,9 @@ Each gear file holds, in millimetres and on layers of their own:
     A centre mark: two ``LINE`` entities, each two modules long, crossing at the centre.
 
 The train sheet (:func:`write_train_sheet`) places several gears at given poses
-on one drawing, with a ``TEXT`` label per gear on ``LABELS``.
+on one drawing, with a ``TEXT`` label per gear on ``LABELS``. A plate cam
+(:func:`write_cam_dxf`) is laid out like a gear: its working profile on
+``OUTLINE``, the roller centre's path on ``PITCH``, bore and centre mark.
 
 The dense outline of the generator (thousands of points) is thinned by
 Douglas-Peucker with a chord tolerance: every dropped point lies within the

@@ -4,13 +4,15 @@ A parameter file names its mechanism kind and holds one table per part of the de
 
 * ``mechanism = "planting"`` (kind 1, :class:`PlantingParameters`): the differential
   planetary planting mechanism, tables ``[pitch_curve]``, ``[train]``, ``[planter]``,
-  ``[field]`` and the optional ``[housing]``, ``[targets]``, ``[resolution]``;
+  ``[field]`` and the optional ``[housing]``, ``[targets]``, ``[resolution]``, ``[gears]``,
+  ``[cam]``, ``[ground]``, ``[solids]``;
 * ``mechanism = "pricking"`` (kind 2, :class:`PrickingParameters`): the inclined
   hole-pricking mechanism, inverse-designed from its needle-tip loop, tables
   ``[trajectory]``, ``[linkage]``, ``[field]`` and the optional ``[gears]``,
-  ``[resolution]``. Only the structure of the type-value points is checked here
-  (at least 5 pairs of finite numbers); their geometry (repeated points,
-  self-intersection, the sun centre inside the loop) is the kinematic model's to judge.
+  ``[resolution]``, ``[housing]``, ``[ground]``, ``[solids]``. Only the structure of the
+  type-value points is checked here (at least 5 pairs of finite numbers); their geometry
+  (repeated points, self-intersection, the sun centre inside the loop) is the kinematic
+  model's to judge.
 
 The schema is a set of frozen pydantic models, strict about types (a quoted ``"36"``
 is not a number, ``true`` is not a number, an integer is accepted where a float is
@@ -42,6 +44,7 @@ inconsistent        a value contradicts a rule that needs no kinematics (``2*e2`
 duplicate           a plant spacing or an inclination given twice (reported at the repeat)
 not_allowed         a value outside a fixed set of choices: ``trajectory.degree`` not 3 or 5,
                     ``gears.split_exponent`` a string other than ``"equal-perimeter"``
+wall_too_thin       ``housing.wall`` below the 2-mm minimum (:data:`MIN_WALL`)
 ==================  =====================================================================
 
 Where array problems are reported: an array item at its index
@@ -103,6 +106,10 @@ from .pricking import (
     SplitExponent,
     TrajectoryParameters,
 )
+from .cam import CamParameters, CamTimingParameters, DuckbillParameters, LeverParameters
+from .cutting import CuttingParameters
+from .solids import MIN_WALL, GroundParameters, ShellParameters, SolidsParameters
+
 __all__ = [
     "ParameterError",
     "LimaconParameters",
@@ -123,6 +130,15 @@ __all__ = [
     "PrickingResolutionParameters",
     "PrickingParameters",
     "SplitExponent",
+    "CuttingParameters",
+    "CamParameters",
+    "DuckbillParameters",
+    "LeverParameters",
+    "CamTimingParameters",
+    "ShellParameters",
+    "GroundParameters",
+    "SolidsParameters",
+    "MIN_WALL",
     "DesignParameters",
     "MECHANISM_KINDS",
     "NAME_PATTERN",
