@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 import shapely.errors
 
@@ -150,28 +151,29 @@ def _choose_cutters(curve: ArcLengthCurve, teeth: int, system: ToothSystem, phas
     return cutters, concave, concave_min, shaper_teeth
 
 
-def _tooth_thickness(curve: ArcLengthCurve, gear, teeth: int, pitch: float, phase: float,
-                     height: float, samples: int = 8192):
+def _tooth_thickness(frame, gear, teeth: int, pitch: float, phase: float, height: float):
     """Width of every tooth along the pitch curve's offset at ``height`` (mm; 0 where it has none).
 
     Measured on the finished outline: the offset curve is cut by the gear
     polygon into one piece per tooth, so undercut and pointed teeth need no
-    special case.
+    special case. ``frame`` is ``(s, point, outward)``, the pitch curve sampled
+    densely by arc length (shared by every height).
     """
     import shapely
 
-    s = np.arange(samples) * (curve.length / samples)
-    point, _, outward = curve.frame(s)
-    offset = shapely.LinearRing(point + height * outward)
-    pieces = gear.intersection(offset)
+    s, point, outward = frame
+    offset = point + height * outward
+    pieces = gear.intersection(shapely.LinearRing(offset))
+    pieces = [piece for piece in getattr(pieces, "geoms", [pieces])
+              if not piece.is_empty and piece.length > 0.0]
     width = np.zeros(teeth)
-    for piece in getattr(pieces, "geoms", [pieces]):
-        if piece.is_empty or piece.length == 0.0:
-            continue
-        middle = np.asarray(piece.interpolate(0.5, normalized=True).coords)[0]
-        nearest = s[np.argmin(np.linalg.norm(point + height * outward - middle, axis=1))]
-        k = int(np.round((nearest - phase) / pitch)) % teeth
-        width[k] += piece.length
+    if not pieces:
+        return width
+    middles = shapely.get_coordinates(shapely.line_interpolate_point(pieces, 0.5, normalized=True))
+    # each piece belongs to the tooth whose centre is nearest its middle along the curve
+    nearest = s[cKDTree(offset).query(middles)[1]]
+    index = np.round((nearest - phase) / pitch).astype(int) % teeth
+    np.add.at(width, index, shapely.length(pieces))
     return width
 
 
@@ -198,9 +200,11 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
         if tight or looped:
             undercut.append(k)
     heights = np.linspace(-(system.dedendum - system.tip_radius) * system.module, 0.0, 6)
-    root = np.min([_tooth_thickness(curve, gear, teeth, system.pitch, phase, h)
+    dense = np.arange(8192) * (curve.length / 8192)
+    frame = (dense, *curve.frame(dense)[::2])
+    root = np.min([_tooth_thickness(frame, gear, teeth, system.pitch, phase, h)
                    for h in heights], axis=0)
-    tip = _tooth_thickness(curve, gear, teeth, system.pitch, phase,
+    tip = _tooth_thickness(frame, gear, teeth, system.pitch, phase,
                            system.addendum_height - 1e-4 * system.module)
     pointed = [k for k, t in enumerate(tip) if not t > MIN_TIP_THICKNESS * system.module]
     # pressure-angle deviation: angle between the radius and the pitch curve's normal

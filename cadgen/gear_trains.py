@@ -60,7 +60,11 @@ def _system(cutting, module) -> ToothSystem:
                        backlash=cutting.backlash)
 
 
-def _stage(name, pair, teeth, system, cutting, placement, drive=None):
+#: Poses of the meshing check over one tooth pitch of a circular pair.
+CIRCULAR_PITCH_POSES = 32
+
+
+def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=False):
     bore = cutting.bore_diameter / 2
     options = dict(system=system, bore_radius=bore, flank_points=cutting.flank_points,
                    force_shaper=cutting.cutter == "shaper")
@@ -69,8 +73,12 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None):
                                   **options)
     else:
         generated = generate_pair(pair, teeth, **options)
-    poses = cutting.meshing_poses or max(96, 8 * max(generated.teeth))
-    report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses)
+    # a circular pair's mesh repeats every tooth pitch: one pitch, finely, checks every pose
+    span = pair.period / generated.teeth[0] if circular else None
+    poses = cutting.meshing_poses or (CIRCULAR_PITCH_POSES if circular
+                                      else max(96, 8 * max(generated.teeth)))
+    report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses,
+                           span=span)
     relief = None
     # relieve only a drive cut for this mesh alone: a drive that already meshes elsewhere (an
     # idler of train 1) is not re-cut here; any interference there stays in the report
@@ -82,7 +90,7 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None):
         relieved = dataclasses.replace(generated.profiles[0], outline=outline)
         generated = dataclasses.replace(generated, profiles=(relieved, generated.profiles[1]))
         before = report
-        report = meshing_check(relieved, generated.profiles[1], pair, poses=poses)
+        report = meshing_check(relieved, generated.profiles[1], pair, poses=poses, span=span)
         relief = {"gear": relieved.name, "removed_area_mm2": area, "depth_mm": depth,
                   "overlap_before_mm2": before.overlap_area_max,
                   "interfering_poses_before": before.interference_poses}
@@ -130,18 +138,19 @@ def planting_train(params, mechanism) -> GearTrain:
     z = [int(round(2 * x / module)) for x in radii]
     D = C + a * np.array([math.cos(box), math.sin(box)])
     stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), mechanism.r, mechanism.r),
-                         (z[4], z[4]), system, cutting, (box, D)))
+                         (z[4], z[4]), system, cutting, (box, D), circular=True))
     carrier = mechanism.phi0
     line = np.array([math.cos(carrier), math.sin(carrier)])
     first = _stage("train 1: sun to idler 1", circle_pair(("sun", "idler 1"), radii[0], radii[1]),
-                   (z[0], z[1]), system, cutting, (carrier, np.zeros(2)))
+                   (z[0], z[1]), system, cutting, (carrier, np.zeros(2)), circular=True)
     second = _stage("train 1: idler 1 to idler 2",
                     circle_pair(("idler 1", "idler 2"), radii[1], radii[2]), (z[1], z[2]), system,
-                    cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated))
+                    cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated),
+                    circular=True)
     third = _stage("train 1: idler 2 to planet",
                    circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3]), (z[2], z[3]),
                    system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
-                   drive=_carry(second.generated))
+                   drive=_carry(second.generated), circular=True)
     return GearTrain(tuple(stages + [first, second, third]))
 
 
@@ -216,7 +225,9 @@ def train_report(train: GearTrain) -> dict:
     meshes = [{
         "stage": s.name, "gears": list(s.generated.pair.names),
         "centre_distance_mm": s.generated.pair.centre_distance,
-        "poses": s.meshing.poses, "interference_poses": s.meshing.interference_poses,
+        "poses": s.meshing.poses, "cycle_fraction": s.meshing.cycle_fraction,
+        "poses_per_tooth": s.meshing.poses / (s.meshing.cycle_fraction * s.generated.teeth[0]),
+        "interference_poses": s.meshing.interference_poses,
         "overlap_area_max_mm2": s.meshing.overlap_area_max,
         "backlash_deg": [s.meshing.backlash_min_deg, s.meshing.backlash_max_deg],
         "backlash_arc_max_mm": s.meshing.backlash_arc_max,

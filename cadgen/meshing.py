@@ -43,6 +43,7 @@ class MeshingReport:
     phi_minus_deg: np.ndarray
     seconds: float = 0.0
     overlapping: np.ndarray = None  # poses whose nominal placement overlaps at all
+    cycle_fraction: float = 1.0     # part of the pair's cycle run through (one pitch: 1/z)
 
 
 def _rotate(points, angle):
@@ -98,8 +99,8 @@ def _turns(points, edges_start, edges_end):
 OVERLAP_TOLERANCE = 20e-6
 
 
-def meshing_check(drive, driven, pair, *, poses: int = 384, window: float | None = None
-                  ) -> MeshingReport:
+def meshing_check(drive, driven, pair, *, poses: int = 384, window: float | None = None,
+                  span: float | None = None) -> MeshingReport:
     """Run a pair through one cycle and measure interference, backlash and transmission error.
 
     Parameters
@@ -113,6 +114,10 @@ def meshing_check(drive, driven, pair, *, poses: int = 384, window: float | None
     window : float
         Radius (mm) round the contact point within which vertices are tested
         (default three modules: the whole path of contact of both flanks).
+    span : float, optional
+        Part of the cycle to run through (default all of it). A pair of circular
+        gears repeats its mesh every tooth pitch of the drive, so one pitch
+        (``period / z_drive``) checks every pose there is.
     """
     import time
 
@@ -122,7 +127,7 @@ def meshing_check(drive, driven, pair, *, poses: int = 384, window: float | None
     start = time.perf_counter()
     module = drive.module
     window = 3.0 * module if window is None else window
-    tau = (np.arange(poses) + 0.382) * (pair.period / poses)
+    tau = (np.arange(poses) + 0.382) * ((pair.period if span is None else span) / poses)
     theta_a, theta_b = pair.rotations(tau)
     rho_a, _, psi_a, _ = pair.drive(tau)
     rho_b, _, psi_b, _ = pair.driven(tau)
@@ -170,7 +175,8 @@ def meshing_check(drive, driven, pair, *, poses: int = 384, window: float | None
         transmission_error_pp_deg=float(np.degrees(max(np.ptp(plus), np.ptp(minus)))),
         free_play_max_deg=float(np.degrees(np.minimum(plus, -minus).max())),
         phi_plus_deg=np.degrees(plus), phi_minus_deg=np.degrees(minus),
-        seconds=time.perf_counter() - start, overlapping=overlapping)
+        seconds=time.perf_counter() - start, overlapping=overlapping,
+        cycle_fraction=1.0 if span is None else float(span / pair.period))
 
 
 def relieve_interference(drive, driven, pair, report: MeshingReport, *, substeps: int = 12,

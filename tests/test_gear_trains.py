@@ -25,6 +25,7 @@ def test_every_planting_mesh_runs_its_cycle_without_interference(planting):
     _, train = planting
     report = train_report(train)
     assert len(report["meshes"]) == 5 and not report["failures"]
+    teeth = {g["gear"]: g["teeth"] for g in report["gears"]}
     for mesh in report["meshes"]:
         module = [g for g in train.stages if g.name == mesh["stage"]][0].generated.system.module
         # stated tolerance: overlap below 20e-6 square modules (the peer's own threshold)
@@ -32,7 +33,11 @@ def test_every_planting_mesh_runs_its_cycle_without_interference(planting):
         assert mesh["interference_poses"] == 0
         # stated bound: transmission error below 0.02 deg peak to peak at the default resolution
         assert mesh["transmission_error_pp_deg"] < 0.02
-        assert mesh["poses"] >= 96
+        # every pose of a cycle: a circular pair repeats each tooth pitch, so one pitch will do
+        assert mesh["poses_per_tooth"] >= 8
+        drive_teeth = teeth[mesh["gears"][0]]
+        assert mesh["cycle_fraction"] == (1.0 if mesh["stage"] == "non-circular pair"
+                                          else pytest.approx(1 / drive_teeth))
 
 
 def test_non_circular_pair_needs_a_shaper_and_tip_relief(planting):

@@ -1,0 +1,660 @@
+"""A design's report as one self-contained HTML page: tables and plots for a person.
+
+The page embeds every figure as a ``data:`` URI and carries its own CSS, so it
+opens anywhere (an e-mail attachment, an offline laptop) and references nothing
+outside itself: no scripts, fonts, style sheets or images to fetch. It is a pure
+function of the report and the figures (no dates, no dictionary-order surprises
+in the figure gallery), so the same design gives the same bytes.
+
+Sections that a report lacks are left out, so reports of either mechanism kind,
+and reports with or without gears, cam, solids, sweep or stage statuses, render.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+import os
+import re
+import struct
+from pathlib import Path
+
+__all__ = ["render_html", "write_html", "load_figures", "figure_caption", "overall_checks"]
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+# Suffixes of report keys that name a unit, longest first so "_mm_s" wins over "_s".
+_UNIT_SUFFIXES = (
+    ("_kg_mm2", "kg·mm²"), ("_kg_m3", "kg/m³"), ("_mm_s", "mm/s"), ("_per_mm", "1/mm"),
+    ("_mm2", "mm²"), ("_mm3", "mm³"), ("_mm", "mm"), ("_deg", "deg"), ("_rad", "rad"),
+    ("_rpm", "r/min"), ("_kg", "kg"), ("_s", "s"),
+)
+
+# Figure gallery groups, in page order: (heading, words that put a file in the group).
+_FIGURE_GROUPS = (
+    ("Paths, attitude and velocity", ("path", "attitude", "velocity", "loop", "field")),
+    ("Gears", ("gear", "pitch", "ratio")),
+    ("Cam", ("cam",)),
+    ("Solids and assembly", ("assembly", "solid", "part", "housing")),
+    ("Clearance and interference sweep", ("clearance", "sweep", "interference", "distance")),
+)
+
+_CSS = """
+body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-serif;
+ margin:0;background:#f4f5f7;color:#1d2430;font-size:14px;line-height:1.45}
+main{max-width:1320px;margin:0 auto;padding:20px 28px 48px;background:#fff}
+h1{font-size:26px;margin:4px 0 6px}
+h2{font-size:19px;margin:30px 0 10px;padding-bottom:4px;border-bottom:2px solid #d8dde6}
+h3{font-size:15px;margin:18px 0 6px}
+.sub{color:#556070;margin:0 0 10px}
+nav{margin:10px 0 4px;font-size:13px}
+nav a{margin-right:14px;color:#2457a6;text-decoration:none}
+table{border-collapse:collapse;margin:6px 0 12px;font-size:13px}
+th,td{border:1px solid #d8dde6;padding:4px 8px;text-align:left;vertical-align:top}
+th{background:#eef1f5;font-weight:600}
+tbody tr:nth-child(even){background:#fafbfc}
+td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+table.kv td:first-child{color:#3b4656;white-space:nowrap}
+table.kv table{margin:0}
+tr.fail td{background:#fdf0ef}
+.badge{display:inline-block;padding:1px 8px;border-radius:10px;font-weight:700;font-size:12px}
+.pass{background:#dff3e5;color:#176b32}
+.fail{background:#fbe2df;color:#a4231b}
+.warn{background:#fff0d4;color:#825600}
+.verdict{font-size:20px;padding:4px 16px;border-radius:14px;margin-right:10px}
+.hash{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:12px;word-break:break-all}
+ul.issues{margin:4px 0 12px;padding-left:20px}
+ul.issues li{margin:3px 0}
+code{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:12px}
+.gallery{display:grid;grid-template-columns:repeat(auto-fill,minmax(560px,1fr));gap:18px}
+figure{margin:0;border:1px solid #d8dde6;border-radius:6px;padding:8px;background:#fff}
+figure img{display:block;max-width:100%;height:auto;margin:0 auto}
+figcaption{margin-top:6px;font-size:13px}
+figcaption code{color:#6a7482}
+details{margin:8px 0}
+summary{cursor:pointer;font-weight:600}
+.note{color:#556070;font-size:13px}
+"""
+
+
+# ----------------------------------------------------------------------------------------------
+# formatting
+
+
+def _e(value) -> str:
+    """Escape any value as HTML text (quotes too, so it is also safe inside attributes)."""
+    return html.escape(str(value), quote=True)
+
+
+def _number(value, digits: int = 3, trim: bool = False) -> str:
+    """A number as text: ``digits`` decimals, or 3 significant digits when that would show 0."""
+    if value is None:
+        return "—"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int):
+        return str(value)
+    if not isinstance(value, float):
+        return str(value)
+    if not math.isfinite(value):
+        return str(value)
+    if value == 0:
+        return "0"
+    text = f"{value:.{digits}f}"
+    if float(text) == 0 or abs(value) >= 1e9:
+        return f"{value:.3g}"
+    if trim and "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return text
+
+
+def _quantity(value, unit: str = "", digits: int = 3, trim: bool = False) -> str:
+    text = _number(value, digits, trim)
+    return f"{text} {unit}" if unit and value is not None and not isinstance(value, bool) else text
+
+
+def _split_unit(key: str) -> tuple[str, str]:
+    """``"hole_width_mm"`` -> ``("hole width", "mm")``."""
+    for suffix, unit in _UNIT_SUFFIXES:
+        if key.endswith(suffix) and len(key) > len(suffix):
+            return key[: -len(suffix)].replace("_", " "), unit
+    return key.replace("_", " "), ""
+
+
+def _badge(state: str) -> str:
+    """``state`` is "pass", "fail" or "warn"."""
+    return f'<span class="badge {state}">{state.upper()}</span>'
+
+
+def _pass_badge(passed) -> str:
+    return _badge("pass" if passed else "fail")
+
+
+def _degrees_ranges(ranges) -> str:
+    if not ranges:
+        return "none"
+    return ", ".join(f"{_number(a, 1)}–{_number(b, 1)} deg" for a, b in ranges)
+
+
+def _point(point, digits: int = 1) -> str:
+    return "(" + ", ".join(_number(c, digits) for c in point) + ")"
+
+
+# ----------------------------------------------------------------------------------------------
+# generic blocks
+
+
+def _table(headers, rows, numeric=(), row_classes=None) -> str:
+    """An HTML table; cells are HTML already, ``numeric`` column indices are right-aligned."""
+    head = "".join(f"<th>{_e(h)}</th>" for h in headers)
+    body = []
+    for k, row in enumerate(rows):
+        css = f' class="{row_classes[k]}"' if row_classes and row_classes[k] else ""
+        cells = "".join(f'<td class="num">{c}</td>' if i in numeric else f"<td>{c}</td>"
+                        for i, c in enumerate(row))
+        body.append(f"<tr{css}>{cells}</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def _value_html(value, unit: str = "") -> str:
+    """Any JSON value as HTML: dicts and lists of dicts as nested tables, numbers with units."""
+    if isinstance(value, dict):
+        return _key_values(value, unit)
+    if isinstance(value, (list, tuple)):
+        if value and all(isinstance(v, dict) for v in value):
+            keys = list(dict.fromkeys(k for v in value for k in v))
+            rows = [[_value_html(v.get(k), _split_unit(k)[1]) for k in keys] for v in value]
+            return _table([_split_unit(k)[0] for k in keys], rows)
+        if not value:
+            return "none"
+        if all(isinstance(v, (list, tuple)) for v in value):
+            return ", ".join(_value_html(v, unit) for v in value)
+        text = ", ".join(_number(v, trim=True) for v in value)
+        return _e(f"({text}) {unit}".rstrip() if unit else f"({text})")
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return _e(_quantity(value, unit, trim=True))
+    return _e(_number(value))
+
+
+def _key_values(mapping: dict, unit: str = "") -> str:
+    """A two-column table of a dict; keys lose their unit suffix, values gain the unit."""
+    rows = []
+    for key, value in mapping.items():
+        label, own_unit = _split_unit(str(key))
+        shown = f"{label} ({own_unit})" if own_unit and isinstance(value, dict) else label
+        rows.append(f"<tr><td>{_e(shown)}</td><td>{_value_html(value, own_unit or unit)}</td></tr>")
+    return f'<table class="kv"><tbody>{"".join(rows)}</tbody></table>'
+
+
+def _problem_list(problems, state: str = "fail") -> str:
+    """``problems``: dicts with "code" and "message" (and optionally "path" or "stage")."""
+    if not problems:
+        return ""
+    items = []
+    for p in problems:
+        where = p.get("path") or p.get("stage") or ""
+        where = f" <code>{_e(where)}</code>" if where else ""
+        items.append(f"<li>{_badge(state)} <code>[{_e(p.get('code', ''))}]</code>{where} "
+                     f"{_e(p.get('message', ''))}</li>")
+    return f'<ul class="issues">{"".join(items)}</ul>'
+
+
+def _section(anchor: str, title: str, body: str) -> str:
+    return f'<section id="{anchor}"><h2>{_e(title)}</h2>{body}</section>'
+
+
+# ----------------------------------------------------------------------------------------------
+# verdict
+
+
+def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
+    """Every pass/fail check the page's verdict rests on: ``(name, passed, detail)``.
+
+    The design passes when all of them pass: its own targets (metrics, or the
+    pricking forward check), each clearance sweep, every gear cut, the cam
+    cuttable, every housing enclosing its gears, and no stage failed. Gear
+    problems such as undercut and pricking findings are warnings, not failures.
+    """
+    checks = []
+    if report.get("mechanism") == "pricking":
+        check = report.get("verification", {})
+        checks.append(("forward kinematic check", bool(report.get("verified")),
+                       f"tip loop reproduced to {_number(check.get('forward_deviation_mm'))} mm"))
+    else:
+        metrics = report.get("metrics", [])
+        missed = sum(1 for m in metrics if not m["passed"])
+        checks.append(("metric targets", bool(report.get("passed")),
+                       f"{len(metrics) - missed} of {len(metrics)} met"))
+    for name, sweep in report.get("sweep", {}).items():
+        checks.append((f"sweep: {_split_unit(name)[0]}", bool(sweep.get("passed")),
+                       f"minimum {_quantity(sweep.get('minimum_mm'), 'mm')}, target "
+                       f"{_quantity(sweep.get('target_mm'), 'mm')}"))
+    if "gear_train" in report:
+        failures = report["gear_train"].get("failures", [])
+        checks.append(("gears cut", not failures,
+                       f"{len(failures)} could not be cut" if failures else
+                       f"{len(report['gear_train'].get('gears', []))} gears cut"))
+    if "cam" in report:
+        cam = report["cam"]
+        ok = bool(cam.get("cuttable", True)) and not cam.get("problems")
+        checks.append(("cam", ok, "cuttable" if ok else f"{len(cam.get('problems', []))} problems"))
+    if "solids" in report:
+        rows = report["solids"].get("enclosure", [])
+        ok = all(r.get("gears_enclosed", True) and r.get("axial_fit", True) for r in rows)
+        checks.append(("housings enclose their gears", ok, f"{len(rows)} housings"))
+    failed = [s["stage"] for s in report.get("stages", []) if s.get("status") == "failed"]
+    if "stages" in report:
+        checks.append(("stages ran", not failed, ", ".join(failed) + " failed" if failed else
+                       f"{len(report['stages'])} stages"))
+    return checks
+
+
+def _header(report: dict) -> str:
+    checks = overall_checks(report)
+    passed = all(ok for _, ok, _ in checks)
+    failed = sum(1 for _, ok, _ in checks if not ok)
+    verdict = (f'<span class="badge verdict pass">PASS</span>all {len(checks)} checks met'
+               if passed else
+               f'<span class="badge verdict fail">FAIL</span>{failed} of {len(checks)} checks failed')
+    facts = {"mechanism": f"{report.get('mechanism', '?')} mechanism"}
+    if "preset" in report:
+        facts["preset"] = str(report["preset"])
+    if "scene" in report:
+        scene = report["scene"]
+        effects = ", ".join(scene.get("effects", [])) or "none"
+        facts["scene"] = f"{scene.get('case', '?')} (effects: {effects})"
+    facts["versions"] = ", ".join(f"{k} {v}" for k, v in report.get("versions", {}).items())
+    rows = "".join(f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in facts.items())
+    rows += (f'<tr><td>input SHA-256</td><td class="hash">'
+             f'{_e(report.get("input_sha256", "—"))}</td></tr>')
+    check_rows = [[_e(name), _pass_badge(ok), _e(detail)] for name, ok, detail in checks]
+    return (f"<header><h1>{_e(report.get('design', 'design'))}</h1>"
+            f'<p class="sub">{_e(facts["mechanism"])} design report</p>'
+            f"<p>{verdict}</p>"
+            f'<table class="kv"><tbody>{rows}</tbody></table>'
+            + _table(["check", "result", "detail"], check_rows,
+                     row_classes=["" if ok else "fail" for _, ok, _ in checks])
+            + "</header>")
+
+
+# ----------------------------------------------------------------------------------------------
+# mechanism sections
+
+
+def _metrics_section(report: dict) -> str:
+    rows, classes = [], []
+    for m in report.get("metrics", []):
+        spacing = _quantity(m["spacing_mm"], "mm", trim=True) if m.get("spacing_mm") is not None else ""
+        rows.append([_e(m["label"]), _e(spacing), _e(_quantity(m["value"], m.get("unit", ""))),
+                     _e(f"{m['target']} {m.get('unit', '')}".strip()), _pass_badge(m["passed"])])
+        classes.append("" if m["passed"] else "fail")
+    body = _table(["metric", "plant spacing", "value", "target", "result"], rows,
+                  numeric=(1, 2), row_classes=classes)
+    return _section("metrics", "Design metrics against targets", body)
+
+
+def _planting_motion_section(report: dict) -> str:
+    parts = []
+    events = report.get("events")
+    if events:
+        angles, attitude = events.get("carrier_angle_deg", {}), events.get("attitude_deg", {})
+        rows = [[_e(name), _e(_quantity(angles.get(name), "deg", 2)),
+                 _e(_quantity(attitude.get(name), "deg", 2))]
+                for name in dict.fromkeys([*angles, *attitude])]
+        parts.append("<h3>Events over one carrier turn</h3>"
+                     + _table(["event", "carrier angle", "attitude Ψ"], rows, numeric=(1, 2)))
+        rest = {k: v for k, v in events.items() if k not in ("carrier_angle_deg", "attitude_deg")}
+        parts.append(_key_values(rest))
+    spacings = report.get("per_spacing")
+    if spacings:
+        rows = [[_e(_quantity(s["spacing_mm"], "mm", trim=True)),
+                 _e(_quantity(s["hole_width_mm"], "mm")),
+                 _e(_quantity(s["hole_verticality_mm"], "mm")),
+                 _e(_quantity(s["hole_span_mm"], "mm")),
+                 _e(_number(s["x_entry_mm"], 2)), _e(_number(s["x_exit_mm"], 2)),
+                 _e(_number(s["x_lowest_mm"], 2)),
+                 _e(_point(s["tip_velocity_absolute_lowest_mm_s"], 2) + " mm/s")]
+                for s in spacings]
+        parts.append("<h3>Per plant spacing</h3>" + _table(
+            ["spacing", "hole width", "verticality", "span", "x entry (mm)", "x exit (mm)",
+             "x lowest (mm)", "tip velocity at lowest point"], rows, numeric=tuple(range(8))))
+    if "derived" in report:
+        parts.append("<h3>Derived geometry</h3>" + _key_values(report["derived"]))
+    return _section("motion", "Planting motion and derived geometry", "".join(parts)) if parts else ""
+
+
+def _pricking_section(report: dict) -> str:
+    field = report.get("field", {})
+    rows, classes = [], []
+    for r in field.get("per_inclination", []):
+        root = r.get("needle_root_in_soil")
+        rows.append([_e(_quantity(r["inclination_deg"], "deg", 1)),
+                     _e(_quantity(r["needle_entry_angle_deg"], "deg", 2)),
+                     _e(_quantity(r["needle_exit_angle_deg"], "deg", 2)),
+                     _e(_quantity(r["hole_mouth_mm"], "mm", 2)),
+                     _e(_quantity(r["time_in_soil_deg"], "deg", 1)),
+                     _e(_degrees_ranges(r.get("slow_windows_deg"))),
+                     _e(_quantity(r["slow_window_total_deg"], "deg", 1)),
+                     _e(_quantity(r["projected_height_mm"], "mm", 1)),
+                     _e(_quantity(r["width_mm"], "mm", 1)),
+                     _badge("fail") + " yes" if root else "no"])
+        classes.append("fail" if root else "")
+    note = (f'<p class="note">carrier at {_number(field.get("carrier_speed_rpm"), trim=True)} r/min, '
+            f'forward speed {_number(field.get("forward_speed_mm_s"), trim=True)} mm/s, depth '
+            f'{_number(field.get("depth_mm"), trim=True)} mm; {_e(field.get("angles", ""))}</p>')
+    body = [note, _table(["inclination", "needle entry", "needle exit", "hole mouth", "in soil",
+                          "slow windows", "slow total", "height", "width", "needle root in soil"],
+                         rows, numeric=(0, 1, 2, 3, 4, 6, 7, 8), row_classes=classes)]
+    findings = report.get("findings", [])
+    body.append(f"<h3>Findings ({len(findings)})</h3>"
+                + (_problem_list(findings, "warn") or '<p class="note">none</p>'))
+    gears = report.get("gears", {})
+    if gears.get("pitch_curves"):
+        rows = [[_e(g["name"]), _e(str(g["stage"])), _e(g["role"]),
+                 _e(_number(g["perimeter_mm"])),
+                 _e(f"{_number(g['radius_min_mm'], 2)}–{_number(g['radius_max_mm'], 2)}"),
+                 _e(_number(g["curvature_min_per_mm"], 4)),
+                 "yes" if g["convex"] else _badge("warn") + " no",
+                 _e(_number(g["pressure_angle_deviation_max_deg"], 1)),
+                 _e(_number(g["convex_radius_of_curvature_min_mm"], 2)),
+                 _badge("warn") + " yes" if g["undercut"] else "no"]
+                for g in gears["pitch_curves"]]
+        body.append("<h3>Pitch curves</h3>" + _table(
+            ["gear", "stage", "role", "perimeter (mm)", "radius (mm)", "min curvature (1/mm)",
+             "convex", "pressure-angle deviation (deg)", "min convex ρ (mm)", "undercut"],
+            rows, numeric=(3, 4, 5, 7, 8)))
+    rest = {k: v for k, v in gears.items() if k != "pitch_curves"}
+    for title, data in (("Linkage", report.get("linkage")), ("Gear split", rest),
+                        ("Verification", report.get("verification"))):
+        if data:
+            body.append(f"<h3>{title}</h3>" + _key_values(data))
+    return _section("field", "Field behaviour per inclination", "".join(body))
+
+
+def _sweep_section(report: dict) -> str:
+    sweeps = report.get("sweep")
+    if not sweeps:
+        return ""
+    names = list(sweeps)
+    fields = (
+        ("result", lambda s: _pass_badge(s.get("passed"))),
+        ("minimum", lambda s: _e(_quantity(s.get("minimum_mm"), "mm"))),
+        ("certified lower bound", lambda s: _e(_quantity(s.get("certified_bound_mm"), "mm"))),
+        ("target (smallest allowed)", lambda s: _e(_quantity(s.get("target_mm"), "mm"))),
+        ("where (carrier angle)", lambda s: _e(_quantity(s.get("carrier_angle_deg"), "deg", 2))),
+        ("nearest parts", lambda s: _e(" ↔ ".join(map(str, s.get("nearest") or [])) or "—")),
+        ("nearest points (mm)", lambda s: _e(" ↔ ".join(_point(p) for p in
+                                                        s.get("nearest_points_mm") or []) or "—")),
+        ("interference ranges", lambda s: _e(_degrees_ranges(s.get("interference_ranges_deg")))),
+        ("kinematic estimate", lambda s: _e(_quantity(s.get("kinematic_estimate_mm"), "mm"))),
+        ("evaluations", lambda s: _e(_number(s.get("evaluations")))),
+        ("method", lambda s: _e(s.get("method", "—"))),
+    )
+    rows = [[_e(label)] + [cell(sweeps[n]) for n in names] for label, cell in fields]
+    headers = ["", *(_split_unit(n)[0] for n in names)]
+    body = _table(headers, rows, numeric=tuple(range(1, len(names) + 1)))
+    return _section("sweep", "Interference and clearance sweep", body)
+
+
+def _gears_section(report: dict) -> str:
+    train = report.get("gear_train")
+    if train is None:
+        return ""
+    rows, problems = [], []
+    for g in train.get("gears", []):
+        cutter = g["cutter"] + (f" (z = {g['shaper_teeth']})" if g.get("shaper_teeth") else "")
+        codes = ", ".join(p["code"] for p in g.get("problems", []))
+        rows.append([_e(g["gear"]), _e(g["stage"]), _e(str(g["teeth"])),
+                     _e(_number(g["module_mm"], 4)), _e(cutter), "yes" if g["convex"] else "no",
+                     _e(str(len(g["undercut_teeth"]))), _e(str(len(g["pointed_teeth"]))),
+                     _e(_number(g["root_thickness_min_mm"])),
+                     _e(_number(g["tip_thickness_min_mm"])),
+                     _badge("warn") + " " + _e(codes) if codes else "—"])
+        problems += g.get("problems", [])
+    body = [_table(["gear", "stage", "teeth", "module (mm)", "cutter", "convex", "undercut teeth",
+                    "pointed teeth", "min root thickness (mm)", "min tip thickness (mm)",
+                    "problems"], rows, numeric=(2, 3, 6, 7, 8, 9))
+            if rows else '<p class="note">no gears were cut</p>']
+    body.append(_problem_list(problems, "warn"))
+    mesh_rows, classes = [], []
+    for m in train.get("meshes", []):
+        relief = m.get("tip_relief")
+        relief_text = (f"{relief['gear']}: {_number(relief['removed_area_mm2'])} mm², "
+                       f"{_number(relief['depth_mm'])} mm deep" if relief else "—")
+        low, high = m["backlash_deg"]
+        mesh_rows.append([_e(m["stage"]), _e(" / ".join(m["gears"])),
+                          _e(_number(m["centre_distance_mm"])),
+                          _e(f"{m['interference_poses']} of {m['poses']}"),
+                          _e(f"{m['overlap_area_max_mm2']:.1e}"), _e(f"{low:.1e}–{high:.1e}"),
+                          _e(f"{m['transmission_error_pp_deg']:.1e}"), _e(relief_text)])
+        classes.append("fail" if m["interference_poses"] else "")
+    if mesh_rows:
+        body.append("<h3>Meshes</h3>" + _table(
+            ["stage", "gears", "centre distance (mm)", "interfering poses", "largest overlap (mm²)",
+             "backlash (deg)", "transmission error p-p (deg)", "tip relief"],
+            mesh_rows, numeric=(2, 3, 4, 5, 6), row_classes=classes))
+    failures = train.get("failures", [])
+    if failures:
+        body.append(f"<h3>Gears not cut ({len(failures)})</h3>" + _problem_list(failures))
+    return _section("gears", "Gears", "".join(body))
+
+
+def _cam_section(report: dict) -> str:
+    cam = report.get("cam")
+    if cam is None:
+        return ""
+    state = "pass" if cam.get("cuttable", True) and not cam.get("problems") else "fail"
+    shown = {k: v for k, v in cam.items() if k != "problems"}
+    body = (f"<p>{_badge(state)} "
+            f"{'the roller can follow the contour' if state == 'pass' else 'cam problems below'}</p>"
+            + _key_values(shown) + _problem_list(cam.get("problems", [])))
+    return _section("cam", "Duckbill cam", body)
+
+
+def _solids_section(report: dict) -> str:
+    solids = report.get("solids")
+    if solids is None:
+        return ""
+    rows = [[_e(p["part"]), _e(p["kind"]), _e(str(p["instances"])),
+             _e(_number(p["volume_mm3"], 0)), _e(_number(p["mass_kg"])),
+             _e(_point(p["centre_of_mass_mm"], 2)), _e(str(p.get("triangles", "—"))),
+             _pass_badge(p.get("watertight", True))]
+            for p in solids.get("parts", [])]
+    assembly = solids.get("assembly", {})
+    body = [f'<p>total mass {_e(_quantity(solids.get("total_mass_kg"), "kg"))} at density '
+            f'{_e(_number(solids.get("density_kg_m3"), trim=True))} kg/m³; assembly '
+            f'<code>{_e(assembly.get("file", "—"))}</code> at carrier angle '
+            f'{_e(_number(assembly.get("carrier_angle_deg"), trim=True))} deg</p>',
+            _table(["part", "kind", "instances", "volume (mm³)", "mass each (kg)",
+                    "centre of mass (mm)", "triangles", "watertight"], rows, numeric=(2, 3, 4, 6))]
+    enclosure, classes = [], []
+    for r in solids.get("enclosure", []):
+        ok = r.get("gears_enclosed", True) and r.get("axial_fit", True)
+        margin = r.get("smallest_margin_mm")
+        enclosure.append([_e(r["housing"]), _pass_badge(r.get("gears_enclosed")),
+                          _e(_quantity(margin, "mm") if margin is not None else
+                             "coarse estimate (no gears cut)"),
+                          _e(r.get("nearest_gear") or "—"), _pass_badge(r.get("axial_fit"))])
+        classes.append("" if ok else "fail")
+    if enclosure:
+        body.append("<h3>Enclosure</h3>" + _table(
+            ["housing", "encloses its gears", "smallest margin", "nearest gear", "axial fit"],
+            enclosure, numeric=(2,), row_classes=classes))
+    if solids.get("frames"):
+        body.append(f'<p class="note">{_e(solids["frames"])}</p>')
+    return _section("solids", "Solids", "".join(body))
+
+
+def _stages_section(report: dict) -> str:
+    if "stages" in report:
+        stages = report["stages"]
+    else:
+        stages = [{"stage": k, "seconds": v} for k, v in report.get("stages_s", {}).items()]
+    if not stages:
+        return ""
+    with_status = any("status" in s for s in stages)
+    rows, classes = [], []
+    for s in stages:
+        row = [_e(s["stage"]), _e(_number(s.get("seconds"), 3))]
+        if with_status:
+            status = s.get("status", "ok")
+            badge = {"ok": "pass", "failed": "fail"}.get(status, "warn")
+            row += [f'<span class="badge {badge}">{_e(status)}</span>', _e(s.get("message", ""))]
+        rows.append(row)
+        classes.append("fail" if s.get("status") == "failed" else "")
+    total = sum(float(s.get("seconds") or 0.0) for s in stages)
+    rows.append(["<b>total</b>", f"<b>{_e(_number(total))}</b>"] + (["", ""] if with_status else []))
+    classes.append("")
+    headers = ["stage", "seconds"] + (["status", "message"] if with_status else [])
+    return _section("stages", "Stages", _table(headers, rows, numeric=(1,), row_classes=classes))
+
+
+def _accuracy_section(report: dict) -> str:
+    if not report.get("accuracy"):
+        return ""
+    return _section("accuracy", "Accuracy achieved", _key_values(report["accuracy"]))
+
+
+def _parameters_section(report: dict) -> str:
+    if not report.get("parameters"):
+        return ""
+    return _section("parameters", "Input parameters",
+                    f"<details><summary>show the validated parameters</summary>"
+                    f"{_key_values(report['parameters'])}</details>")
+
+
+# ----------------------------------------------------------------------------------------------
+# figures
+
+
+def _natural_key(text: str):
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", text)]
+
+
+def figure_caption(name: str) -> str:
+    """A caption from a figure's file name: ``"gears-3-train-1-sun-to-idler-1.png"`` ->
+    ``"Gear pair 3: train 1 sun to idler 1"``, ``"tip_velocity.png"`` -> ``"Tip velocity"``."""
+    stem = Path(name).stem
+    match = re.fullmatch(r"gears-(\d+)-(.+)", stem)
+    if match:
+        return f"Gear pair {match[1]}: {match[2].replace('-', ' ')}"
+    words = re.sub(r"[-_]+", " ", stem).strip()
+    return words[:1].upper() + words[1:] if words else name
+
+
+def _figure_group(name: str) -> int:
+    stem = Path(name).stem.lower()
+    for index, (_, words) in enumerate(_FIGURE_GROUPS):
+        if any(word in stem for word in words):
+            return index
+    return len(_FIGURE_GROUPS)
+
+
+def _png_size(data: bytes) -> tuple[int, int] | None:
+    # Width and height are the first two fields of the IHDR chunk right after the signature.
+    if len(data) >= 24 and data[12:16] == b"IHDR":
+        return struct.unpack(">II", data[16:24])
+    return None
+
+
+def _figure_html(name: str, data: bytes) -> str:
+    caption = figure_caption(name)
+    size = _png_size(data)
+    dims = f' width="{size[0]}" height="{size[1]}"' if size else ""
+    encoded = base64.b64encode(data).decode("ascii")
+    return (f'<figure><img src="data:image/png;base64,{encoded}" alt="{_e(caption)}"{dims}>'
+            f"<figcaption>{_e(caption)} <code>{_e(name)}</code></figcaption></figure>")
+
+
+def _figures_section(figures: dict) -> str:
+    if not figures:
+        return ""
+    groups: dict[int, list[str]] = {}
+    for name in sorted(figures, key=_natural_key):
+        groups.setdefault(_figure_group(name), []).append(name)
+    parts = []
+    for index in sorted(groups):
+        title = _FIGURE_GROUPS[index][0] if index < len(_FIGURE_GROUPS) else "Other figures"
+        items = "".join(_figure_html(name, figures[name]) for name in groups[index])
+        parts.append(f'<h3>{_e(title)}</h3><div class="gallery">{items}</div>')
+    return _section("figures", "Figures", "".join(parts))
+
+
+# ----------------------------------------------------------------------------------------------
+# page
+
+
+def render_html(report: dict, figures: dict[str, bytes] | None = None) -> str:
+    """The report and its figures as one self-contained HTML page.
+
+    Parameters
+    ----------
+    report : dict
+        A design's report (the content of ``report.json``), of either mechanism kind.
+        Optional sections (``gear_train``, ``cam``, ``solids``, ``sweep``, ``stages``,
+        ``scene``, ``preset``) are shown when present.
+    figures : dict of str to bytes, optional
+        PNG files by file name (``"attitude.png"``); embedded as ``data:`` URIs and
+        grouped by what they show.
+
+    Returns
+    -------
+    str
+        The page: inline CSS, no scripts, no external references; the same input
+        gives the same string.
+
+    Raises
+    ------
+    ValueError
+        If a figure is not PNG data.
+    """
+    if not isinstance(report, dict):
+        raise TypeError(f"report must be a dict, not {type(report).__name__}")
+    figures = dict(figures or {})
+    for name, data in figures.items():
+        if not isinstance(data, (bytes, bytearray)) or not bytes(data).startswith(_PNG_SIGNATURE):
+            raise ValueError(f"figure {name!r} is not PNG data")
+        figures[name] = bytes(data)
+    if report.get("mechanism") == "pricking":
+        mechanism = [_pricking_section(report)]
+    else:
+        mechanism = [_metrics_section(report), _planting_motion_section(report)]
+    sections = [*mechanism, _sweep_section(report), _gears_section(report), _cam_section(report),
+                _solids_section(report), _figures_section(figures), _stages_section(report),
+                _accuracy_section(report), _parameters_section(report)]
+    sections = [s for s in sections if s]
+    titles = re.findall(r'<section id="([^"]+)"><h2>([^<]+)</h2>', "".join(sections))
+    nav = "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t in titles) + "</nav>"
+    title = _e(f"{report.get('design', 'design')}: cadgen report")
+    return ("<!DOCTYPE html>\n"
+            f'<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>{title}</title><style>{_CSS}</style></head>\n"
+            f"<body><main>{_header(report)}{nav}\n" + "\n".join(sections)
+            + "\n</main></body></html>\n")
+
+
+def write_html(report: dict, figures: dict[str, bytes] | None,
+               path: str | os.PathLike) -> Path:
+    """Render the page (:func:`render_html`) and write it to ``path`` atomically.
+
+    Returns
+    -------
+    Path
+        The written file; its directory must exist.
+    """
+    from .atomic import write_text_atomic
+
+    return write_text_atomic(path, render_html(report, figures))
+
+
+def load_figures(directory: str | os.PathLike) -> dict[str, bytes]:
+    """Every ``*.png`` in ``directory`` (e.g. ``outputs/<design>/plots``), by file name.
+
+    A missing directory gives no figures.
+    """
+    directory = Path(directory)
+    if not directory.is_dir():
+        return {}
+    return {p.name: p.read_bytes() for p in sorted(directory.glob("*.png"))}
