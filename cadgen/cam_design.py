@@ -12,7 +12,7 @@ from kinematics.cam import CamCheck, CamProfile, CamTiming, cam_timing
 from kinematics.duckbill import DuckbillLinkage
 from kinematics.motion_laws import FollowerProgram
 
-__all__ = ["CamDesign", "design_cam", "cam_report"]
+__all__ = ["CamDesign", "design_cam", "cam_report", "cam_section"]
 
 
 @dataclass(frozen=True)
@@ -105,3 +105,11 @@ def cam_report(design: CamDesign) -> dict:
         "problems": [{"path": p.path, "code": p.code, "message": p.message}
                      for p in check.problems],
     }
+
+
+def cam_section(design: CamDesign) -> dict:
+    """The report's cam section, saying when no cam.dxf is written."""
+    section = cam_report(design)
+    if not design.cuttable:
+        section["not_written"] = "cam.dxf is not written: the roller cannot follow this contour"
+    return section

@@ -1,7 +1,8 @@
-"""Command line: ``cadgen validate`` and ``cadgen analyze``.
+"""Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``) and ``cadgen batch``.
 
-Exit codes: 0 success, 2 a parameter file or design with problems (also argparse's
-code for a bad command line). numpy, scipy, matplotlib and pydantic are imported
+Exit codes: 0 success, 1 a design that was built but misses a target or fails a
+check (the report says which), 2 a parameter file or design with problems
+(nothing is written; also argparse's code for a bad command line). numpy, scipy, matplotlib and pydantic are imported
 inside the commands only, so ``cadgen --help`` starts fast.
 """
 
@@ -12,9 +13,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_PROBLEMS"]
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_CHECKS_FAILED", "EXIT_PROBLEMS"]
 
 EXIT_OK = 0
+EXIT_CHECKS_FAILED = 1
 EXIT_PROBLEMS = 2
 
 
@@ -60,7 +62,20 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     return status
 
 
-def _cmd_analyze(args: argparse.Namespace) -> int:
+def _effects(text: str) -> list:
+    """argparse type of ``--effects``: comma-separated effect names, each known."""
+    from cadgen.params.scene import EFFECTS
+
+    effects = [e.strip() for e in text.split(",") if e.strip()]
+    unknown = [e for e in effects if e not in EFFECTS]
+    if unknown or not effects:
+        raise argparse.ArgumentTypeError(
+            f"unknown effect(s) {', '.join(unknown) or '(none given)'}; choose from "
+            f"{', '.join(EFFECTS)}")
+    return list(dict.fromkeys(effects))
+
+
+def _cmd_build(args: argparse.Namespace) -> int:
     from cadgen.params import ParameterError, load_params
     from kinematics.errors import MechanismError
 
@@ -74,17 +89,32 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         print(f"{args.file}: {exc}", file=sys.stderr)
         return EXIT_PROBLEMS
 
-    from cadgen.analyze import run_analysis
+    import cadgen.build
 
     try:
-        result = run_analysis(
-            params, output_root=Path(args.output_dir), steps_per_revolution=args.steps
-        )
-    except MechanismError as exc:
+        result = cadgen.build.build(params, output_root=Path(args.output_dir),
+                                    effects=args.effects, case=args.case, steps=args.steps)
+    except MechanismError as exc:   # stages report their own failures; this is anything else
         print(f"{args.file}: {exc}", file=sys.stderr)
         return EXIT_PROBLEMS
     print(result.summary_text())
-    return EXIT_OK
+    return result.exit_code
+
+
+def _add_build_arguments(command: argparse.ArgumentParser) -> None:
+    command.add_argument("file", metavar="FILE", help="TOML parameter file")
+    command.add_argument("--output-dir", metavar="DIR", default="outputs",
+                         help="root of the output folders (default: %(default)s)")
+    command.add_argument("--effects", metavar="LIST", type=_effects, default=None,
+                         help="comma-separated effects, overriding [scene] effects: metrics, "
+                              "curves, teeth, meshing, cam, solids, arm_interference, "
+                              "ground_clearance, dxf, stl, plots, report (default: the file's "
+                              "scene, or all)")
+    command.add_argument("--case", choices=("field", "bench"), default=None,
+                         help="operating case, overriding [scene] case")
+    command.add_argument("--steps", metavar="N", type=_steps, default=None,
+                         help="steps per revolution, overriding [resolution] steps_per_revolution")
+    command.set_defaults(handler=_cmd_build)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -105,27 +135,24 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("files", nargs="+", metavar="FILE", help="TOML parameter file")
     validate.set_defaults(handler=_cmd_validate)
 
-    analyze = commands.add_parser(
-        "analyze",
-        help="compute the kinematics and design metrics of one design",
-        description="Compute the kinematics and design metrics of one design and write "
-        "them under OUTPUT_DIR/<name>/. Exit 2 if the file or the design has problems.",
-    )
-    analyze.add_argument("file", metavar="FILE", help="TOML parameter file")
-    analyze.add_argument(
-        "--output-dir",
-        metavar="DIR",
-        default="outputs",
-        help="root of the output folders (default: %(default)s)",
-    )
-    analyze.add_argument(
-        "--steps",
-        metavar="N",
-        type=_steps,
-        default=None,
-        help="steps per revolution, overriding [resolution] steps_per_revolution",
-    )
-    analyze.set_defaults(handler=_cmd_analyze)
+    description = ("Build one design: run exactly the stages its scene's effects need (all by "
+                   "default), write the outputs atomically under OUTPUT_DIR/<name>/ and print "
+                   "the summary. Exit 0 when every target and check passes, 1 when some fail "
+                   "(the report says which), 2 when the file or the design has problems "
+                   "(nothing written).")
+    for name, help_text in (("build", "build one design: metrics, gears, cam, solids, sweeps, "
+                                      "files and report, as its scene asks"),
+                            ("analyze", "the same as build (the earlier name)")):
+        _add_build_arguments(commands.add_parser(name, help=help_text, description=description))
+
+    from cadgen.batch import add_batch_arguments
+
+    batch = commands.add_parser(
+        "batch", help="build many designs (files or a parameter grid), locally or on Dask",
+        description="Build many designs, from parameter files or a grid over one design's "
+        "parameters, in local processes or on a Dask cluster; keep going past failing "
+        "designs; write a summary CSV and HTML table; exit 1 if any design failed.")
+    add_batch_arguments(batch)
     return parser
 
 

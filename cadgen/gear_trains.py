@@ -233,7 +233,6 @@ def train_report(train: GearTrain) -> dict:
         "backlash_arc_max_mm": s.meshing.backlash_arc_max,
         "transmission_error_pp_deg": s.meshing.transmission_error_pp_deg,
         "free_play_max_deg": s.meshing.free_play_max_deg,
-        "check_seconds": s.meshing.seconds,
         "tip_relief": s.relief,
     } for s in train.stages]
     failures = [{"stage": stage, "path": p.path, "code": p.code, "message": p.message}

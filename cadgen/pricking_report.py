@@ -17,15 +17,12 @@ def _gear(gear) -> dict:
     }
 
 
-def pricking_report(params, design, field, timings, versions, input_hash) -> dict:
-    """The JSON report of a pricking design (lengths mm, angles deg)."""
+def pricking_report(params, design, field) -> dict:
+    """The pricking design's sections of the report (lengths mm, angles deg)."""
     linkage = design.linkage
     curve = design.curve
     findings = [{"path": f.path, "code": f.code, "message": f.message} for f in design.findings]
     return {
-        "design": params.name,
-        "mechanism": params.mechanism,
-        "input_sha256": input_hash,
         "verified": bool(design.forward_deviation < 1e-2),
         "findings": findings,
         "linkage": {
@@ -76,9 +73,6 @@ def pricking_report(params, design, field, timings, versions, input_hash) -> dic
                 "needle_root_in_soil": r.needle_root_in_soil,
             } for r in field],
         },
-        "stages_s": timings,
-        "versions": versions,
-        "parameters": params.model_dump(mode="json"),
     }
 
 

@@ -33,8 +33,8 @@ _UNIT_SUFFIXES = (
 
 # Figure gallery groups, in page order: (heading, words that put a file in the group).
 _FIGURE_GROUPS = (
-    ("Paths, attitude and velocity", ("path", "attitude", "velocity", "loop", "field")),
-    ("Gears", ("gear", "pitch", "ratio")),
+    ("Motion: paths, attitude, velocity", ("path", "attitude", "velocity", "loop", "field")),
+    ("Gears", ("pitch", "ratio", "gear")),
     ("Cam", ("cam",)),
     ("Solids and assembly", ("assembly", "solid", "part", "housing")),
     ("Clearance and interference sweep", ("clearance", "sweep", "interference", "distance")),
@@ -67,7 +67,10 @@ tr.fail td{background:#fdf0ef}
 ul.issues{margin:4px 0 12px;padding-left:20px}
 ul.issues li{margin:3px 0}
 code{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:12px}
-.gallery{display:grid;grid-template-columns:repeat(auto-fill,minmax(560px,1fr));gap:18px}
+.gallery{display:grid;grid-template-columns:repeat(auto-fill,minmax(560px,1fr));gap:18px;
+ align-items:start}
+.row{display:flex;flex-wrap:wrap;gap:8px 32px;align-items:flex-start}
+.row>div{min-width:0}
 figure{margin:0;border:1px solid #d8dde6;border-radius:6px;padding:8px;background:#fff}
 figure img{display:block;max-width:100%;height:auto;margin:0 auto}
 figcaption{margin-top:6px;font-size:13px}
@@ -131,6 +134,11 @@ def _pass_badge(passed) -> str:
     return _badge("pass" if passed else "fail")
 
 
+def _scientific(value) -> str:
+    """Small quantities (overlaps, backlash, errors) in 2 significant digits; 0 as "0"."""
+    return "0" if value == 0 else f"{value:.1e}"
+
+
 def _degrees_ranges(ranges) -> str:
     if not ranges:
         return "none"
@@ -138,7 +146,18 @@ def _degrees_ranges(ranges) -> str:
 
 
 def _point(point, digits: int = 1) -> str:
-    return "(" + ", ".join(_number(c, digits) for c in point) + ")"
+    """A position or vector with fixed decimals: round-off noise (1e-15) shows as 0."""
+    return "(" + ", ".join(f"{c + 0.0:.{digits}f}".replace(f"-{0:.{digits}f}", f"{0:.{digits}f}")
+                           for c in point) + ")"
+
+
+def _plural(count: int, noun: str, plural: str = "") -> str:
+    return f"{count} {noun if count == 1 else plural or noun + 's'}"
+
+
+def _row(*blocks: str) -> str:
+    """Blocks side by side, wrapping when the page is narrow."""
+    return '<div class="row">' + "".join(f"<div>{b}</div>" for b in blocks if b) + "</div>"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -157,33 +176,60 @@ def _table(headers, rows, numeric=(), row_classes=None) -> str:
     return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
-def _value_html(value, unit: str = "") -> str:
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _records_table(records: list, index: list | None = None, unit: str = "",
+                   digits: int = 3) -> str:
+    """Dicts as the rows of one table (columns: the union of their keys, in order)."""
+    keys = list(dict.fromkeys(k for r in records for k in r))
+    headers = [_split_unit(k)[0] for k in keys]
+    rows = [[_value_html(r.get(k), _split_unit(k)[1] or unit, digits) for k in keys]
+            for r in records]
+    if index is not None:
+        headers = ["", *headers]
+        rows = [[_e(name), *row] for name, row in zip(index, rows)]
+    return _table(headers, rows)
+
+
+def _value_html(value, unit: str = "", digits: int = 3) -> str:
     """Any JSON value as HTML: dicts and lists of dicts as nested tables, numbers with units."""
     if isinstance(value, dict):
-        return _key_values(value, unit)
+        if len(value) > 1 and all(isinstance(v, dict) and v for v in value.values()):
+            # e.g. {"lowest_point": {"value": ..., "certified": ...}, ...}: one row each
+            return _records_table(list(value.values()), [_split_unit(str(k))[0] for k in value],
+                                  unit, digits)
+        return _key_values(value, unit, digits)
     if isinstance(value, (list, tuple)):
-        if value and all(isinstance(v, dict) for v in value):
-            keys = list(dict.fromkeys(k for v in value for k in v))
-            rows = [[_value_html(v.get(k), _split_unit(k)[1]) for k in keys] for v in value]
-            return _table([_split_unit(k)[0] for k in keys], rows)
         if not value:
             return "none"
+        if all(isinstance(v, dict) for v in value):
+            return _records_table(list(value), None, unit, digits)
         if all(isinstance(v, (list, tuple)) for v in value):
-            return ", ".join(_value_html(v, unit) for v in value)
-        text = ", ".join(_number(v, trim=True) for v in value)
+            return ", ".join(_value_html(v, unit, digits) for v in value)
+        text = ", ".join(_vector_items(value, digits))
         return _e(f"({text}) {unit}".rstrip() if unit else f"({text})")
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return _e(_quantity(value, unit, trim=True))
+    if _is_number(value):
+        return _e(_quantity(value, unit, digits, trim=True))
     return _e(_number(value))
 
 
-def _key_values(mapping: dict, unit: str = "") -> str:
+def _vector_items(values, digits: int = 3) -> list[str]:
+    """Items of a list as text; a number's round-off noise (1e-14 next to 140) reads as 0."""
+    scale = max((abs(v) for v in values if _is_number(v)), default=0.0)
+    return [_number(0.0 if abs(v) < 1e-9 * scale else v, digits, trim=True) if _is_number(v)
+            else _number(v) for v in values]
+
+
+def _key_values(mapping: dict, unit: str = "", digits: int = 3) -> str:
     """A two-column table of a dict; keys lose their unit suffix, values gain the unit."""
     rows = []
     for key, value in mapping.items():
         label, own_unit = _split_unit(str(key))
         shown = f"{label} ({own_unit})" if own_unit and isinstance(value, dict) else label
-        rows.append(f"<tr><td>{_e(shown)}</td><td>{_value_html(value, own_unit or unit)}</td></tr>")
+        cell = _value_html(value, own_unit or unit, digits)
+        rows.append(f"<tr><td>{_e(shown)}</td><td>{cell}</td></tr>")
     return f'<table class="kv"><tbody>{"".join(rows)}</tbody></table>'
 
 
@@ -208,55 +254,87 @@ def _section(anchor: str, title: str, body: str) -> str:
 # verdict
 
 
+def _sweep_name(key: str, sweep: dict) -> str:
+    return str(sweep.get("label") or _split_unit(key)[0])
+
+
 def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
     """Every pass/fail check the page's verdict rests on: ``(name, passed, detail)``.
 
-    The design passes when all of them pass: its own targets (metrics, or the
-    pricking forward check), each clearance sweep, every gear cut, the cam
-    cuttable, every housing enclosing its gears, and no stage failed. Gear
-    problems such as undercut and pricking findings are warnings, not failures.
+    The design passes when all of them pass: its metric targets (planting) or
+    forward check (pricking), each clearance sweep (target met, no interference),
+    every gear cut and meshing free, the cam cuttable, every housing enclosing its
+    gears, every stage ok, and, when the report gives one (``"failures"``), the
+    report's own verdict. Gear problems such as undercut are warnings.
     """
     checks = []
     if report.get("mechanism") == "pricking":
         check = report.get("verification", {})
         checks.append(("forward kinematic check", bool(report.get("verified")),
                        f"tip loop reproduced to {_number(check.get('forward_deviation_mm'))} mm"))
-    else:
-        metrics = report.get("metrics", [])
-        missed = sum(1 for m in metrics if not m["passed"])
-        checks.append(("metric targets", bool(report.get("passed")),
-                       f"{len(metrics) - missed} of {len(metrics)} met"))
-    for name, sweep in report.get("sweep", {}).items():
-        checks.append((f"sweep: {_split_unit(name)[0]}", bool(sweep.get("passed")),
-                       f"minimum {_quantity(sweep.get('minimum_mm'), 'mm')}, target "
-                       f"{_quantity(sweep.get('target_mm'), 'mm')}"))
-    if "gear_train" in report:
-        failures = report["gear_train"].get("failures", [])
+    elif "metrics" in report:
+        metrics = report["metrics"]
+        met = sum(1 for m in metrics if m["passed"])
+        checks.append(("metric targets", met == len(metrics), f"{met} of {len(metrics)} met"))
+    for key, sweep in report.get("sweep", {}).items():
+        ranges = sweep.get("interference_ranges_deg")
+        detail = (f"minimum {_quantity(sweep.get('minimum_mm'), 'mm')}, target > "
+                  f"{_quantity(sweep.get('target_mm'), 'mm', trim=True)}"
+                  + (f", interference over {_degrees_ranges(ranges)}" if ranges else ""))
+        checks.append((f"sweep: {_sweep_name(key, sweep)}",
+                       bool(sweep.get("passed")) and not ranges, detail))
+    train = report.get("gear_train")
+    if train is not None:
+        failures = train.get("failures", [])
         checks.append(("gears cut", not failures,
                        f"{len(failures)} could not be cut" if failures else
-                       f"{len(report['gear_train'].get('gears', []))} gears cut"))
+                       _plural(len(train.get("gears", [])), "gear") + " cut"))
+        if train.get("meshes"):
+            bad = [m["stage"] for m in train["meshes"] if m["interference_poses"]]
+            detail = ", ".join(bad) or _plural(len(train["meshes"]), "mesh", "meshes") + " checked"
+            checks.append(("gear meshes free of interference", not bad, detail))
     if "cam" in report:
         cam = report["cam"]
         ok = bool(cam.get("cuttable", True)) and not cam.get("problems")
-        checks.append(("cam", ok, "cuttable" if ok else f"{len(cam.get('problems', []))} problems"))
+        detail = "cuttable" if ok else _plural(len(cam.get("problems", [])), "problem")
+        checks.append(("cam", ok, detail))
     if "solids" in report:
         rows = report["solids"].get("enclosure", [])
         ok = all(r.get("gears_enclosed", True) and r.get("axial_fit", True) for r in rows)
-        checks.append(("housings enclose their gears", ok, f"{len(rows)} housings"))
-    failed = [s["stage"] for s in report.get("stages", []) if s.get("status") == "failed"]
+        checks.append(("housings enclose their gears", ok, _plural(len(rows), "housing")))
     if "stages" in report:
-        checks.append(("stages ran", not failed, ", ".join(failed) + " failed" if failed else
-                       f"{len(report['stages'])} stages"))
+        bad = [f"{s['stage']} {s.get('status')}" for s in report["stages"]
+               if s.get("status", "ok") != "ok"]
+        checks.append(("stages ran", not bad, ", ".join(bad) or
+                       _plural(len(report["stages"]), "stage") + " ok"))
+    if "failures" in report:
+        failures = report["failures"]
+        checks.append(("report verdict", bool(report.get("passed", not failures)),
+                       "no failures" if not failures else
+                       _plural(len(failures), "failure") + " listed below"))
     return checks
+
+
+def _failure_list(failures, shown: int = 3) -> str:
+    """The report's own reasons for not passing: the first few, the rest folded away."""
+    if not failures:
+        return ""
+    items = [f"<li>{_badge('fail')} {_e(text)}</li>" for text in failures]
+    rest = items[shown:]
+    more = (f"<details><summary>{len(rest)} more</summary>"
+            f'<ul class="issues">{"".join(rest)}</ul></details>' if rest else "")
+    return (f"<h3>Why it does not pass ({len(failures)})</h3>"
+            f'<ul class="issues">{"".join(items[:shown])}</ul>{more}')
 
 
 def _header(report: dict) -> str:
     checks = overall_checks(report)
     passed = all(ok for _, ok, _ in checks)
     failed = sum(1 for _, ok, _ in checks if not ok)
-    verdict = (f'<span class="badge verdict pass">PASS</span>all {len(checks)} checks met'
-               if passed else
-               f'<span class="badge verdict fail">FAIL</span>{failed} of {len(checks)} checks failed')
+    state = "pass" if passed else "fail"
+    detail = (f"all {len(checks)} checks met" if passed
+              else f"{failed} of {len(checks)} checks failed")
+    verdict = f'<span class="badge verdict {state}">{state.upper()}</span>{_e(detail)}'
     facts = {"mechanism": f"{report.get('mechanism', '?')} mechanism"}
     if "preset" in report:
         facts["preset"] = str(report["preset"])
@@ -264,6 +342,8 @@ def _header(report: dict) -> str:
         scene = report["scene"]
         effects = ", ".join(scene.get("effects", [])) or "none"
         facts["scene"] = f"{scene.get('case', '?')} (effects: {effects})"
+        for effect, reason in scene.get("set_aside", {}).items():
+            facts[f"not run: {effect}"] = reason
     facts["versions"] = ", ".join(f"{k} {v}" for k, v in report.get("versions", {}).items())
     rows = "".join(f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in facts.items())
     rows += (f'<tr><td>input SHA-256</td><td class="hash">'
@@ -272,10 +352,10 @@ def _header(report: dict) -> str:
     return (f"<header><h1>{_e(report.get('design', 'design'))}</h1>"
             f'<p class="sub">{_e(facts["mechanism"])} design report</p>'
             f"<p>{verdict}</p>"
-            f'<table class="kv"><tbody>{rows}</tbody></table>'
-            + _table(["check", "result", "detail"], check_rows,
-                     row_classes=["" if ok else "fail" for _, ok, _ in checks])
-            + "</header>")
+            + _row(_table(["check", "result", "detail"], check_rows,
+                          row_classes=["" if ok else "fail" for _, ok, _ in checks]),
+                   f'<table class="kv"><tbody>{rows}</tbody></table>')
+            + _failure_list(report.get("failures")) + "</header>")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -283,14 +363,24 @@ def _header(report: dict) -> str:
 
 
 def _metrics_section(report: dict) -> str:
+    metrics = report.get("metrics", [])
+    # A clearance the solids' sweep measured keeps the kinematic estimate beside it.
+    estimates = any("kinematic_estimate" in m for m in metrics)
     rows, classes = [], []
-    for m in report.get("metrics", []):
-        spacing = _quantity(m["spacing_mm"], "mm", trim=True) if m.get("spacing_mm") is not None else ""
-        rows.append([_e(m["label"]), _e(spacing), _e(_quantity(m["value"], m.get("unit", ""))),
-                     _e(f"{m['target']} {m.get('unit', '')}".strip()), _pass_badge(m["passed"])])
+    for m in metrics:
+        spacing = m.get("spacing_mm")
+        spacing = "" if spacing is None else _quantity(spacing, "mm", trim=True)
+        unit = m.get("unit", "")
+        row = [_e(m["label"]), _e(spacing), _e(_quantity(m["value"], unit)),
+               _e(f"{m['target']} {unit}".strip()), _pass_badge(m["passed"])]
+        if estimates:
+            estimate = m.get("kinematic_estimate")
+            row.append(_e("" if estimate is None else _quantity(estimate, unit)))
+        rows.append(row)
         classes.append("" if m["passed"] else "fail")
-    body = _table(["metric", "plant spacing", "value", "target", "result"], rows,
-                  numeric=(1, 2), row_classes=classes)
+    headers = ["metric", "plant spacing", "value", "target", "result"]
+    body = _table(headers + ["kinematic estimate"] * estimates, rows, numeric=(1, 2, 5),
+                  row_classes=classes)
     return _section("metrics", "Design metrics against targets", body)
 
 
@@ -302,10 +392,10 @@ def _planting_motion_section(report: dict) -> str:
         rows = [[_e(name), _e(_quantity(angles.get(name), "deg", 2)),
                  _e(_quantity(attitude.get(name), "deg", 2))]
                 for name in dict.fromkeys([*angles, *attitude])]
-        parts.append("<h3>Events over one carrier turn</h3>"
-                     + _table(["event", "carrier angle", "attitude Ψ"], rows, numeric=(1, 2)))
         rest = {k: v for k, v in events.items() if k not in ("carrier_angle_deg", "attitude_deg")}
-        parts.append(_key_values(rest))
+        parts.append("<h3>Events over one carrier turn</h3>" + _row(
+            _table(["event", "carrier angle", "attitude Ψ"], rows, numeric=(1, 2)),
+            _key_values(rest)))
     spacings = report.get("per_spacing")
     if spacings:
         rows = [[_e(_quantity(s["spacing_mm"], "mm", trim=True)),
@@ -321,7 +411,9 @@ def _planting_motion_section(report: dict) -> str:
              "x lowest (mm)", "tip velocity at lowest point"], rows, numeric=tuple(range(8))))
     if "derived" in report:
         parts.append("<h3>Derived geometry</h3>" + _key_values(report["derived"]))
-    return _section("motion", "Planting motion and derived geometry", "".join(parts)) if parts else ""
+    if not parts:
+        return ""
+    return _section("motion", "Planting motion and derived geometry", "".join(parts))
 
 
 def _pricking_section(report: dict) -> str:
@@ -340,15 +432,18 @@ def _pricking_section(report: dict) -> str:
                      _e(_quantity(r["width_mm"], "mm", 1)),
                      _badge("fail") + " yes" if root else "no"])
         classes.append("fail" if root else "")
-    note = (f'<p class="note">carrier at {_number(field.get("carrier_speed_rpm"), trim=True)} r/min, '
-            f'forward speed {_number(field.get("forward_speed_mm_s"), trim=True)} mm/s, depth '
-            f'{_number(field.get("depth_mm"), trim=True)} mm; {_e(field.get("angles", ""))}</p>')
+    note = (f"carrier at {_number(field.get('carrier_speed_rpm'), trim=True)} r/min, forward "
+            f"speed {_number(field.get('forward_speed_mm_s'), trim=True)} mm/s, depth "
+            f"{_number(field.get('depth_mm'), trim=True)} mm; {field.get('angles', '')}")
+    note = f'<p class="note">{_e(note)}</p>'
     body = [note, _table(["inclination", "needle entry", "needle exit", "hole mouth", "in soil",
                           "slow windows", "slow total", "height", "width", "needle root in soil"],
                          rows, numeric=(0, 1, 2, 3, 4, 6, 7, 8), row_classes=classes)]
     findings = report.get("findings", [])
+    # Newer reports count findings among their failures; older ones only warn.
+    state = "fail" if "failures" in report else "warn"
     body.append(f"<h3>Findings ({len(findings)})</h3>"
-                + (_problem_list(findings, "warn") or '<p class="note">none</p>'))
+                + (_problem_list(findings, state) or '<p class="note">none</p>'))
     gears = report.get("gears", {})
     if gears.get("pitch_curves"):
         rows = [[_e(g["name"]), _e(str(g["stage"])), _e(g["role"]),
@@ -365,10 +460,9 @@ def _pricking_section(report: dict) -> str:
              "convex", "pressure-angle deviation (deg)", "min convex ρ (mm)", "undercut"],
             rows, numeric=(3, 4, 5, 7, 8)))
     rest = {k: v for k, v in gears.items() if k != "pitch_curves"}
-    for title, data in (("Linkage", report.get("linkage")), ("Gear split", rest),
-                        ("Verification", report.get("verification"))):
-        if data:
-            body.append(f"<h3>{title}</h3>" + _key_values(data))
+    body.append(_row(*(f"<h3>{title}</h3>" + _key_values(data) for title, data in (
+        ("Linkage", report.get("linkage")), ("Gear ratio split", rest),
+        ("Forward check", report.get("verification"))) if data)))
     return _section("field", "Field behaviour per inclination", "".join(body))
 
 
@@ -381,19 +475,21 @@ def _sweep_section(report: dict) -> str:
         ("result", lambda s: _pass_badge(s.get("passed"))),
         ("minimum", lambda s: _e(_quantity(s.get("minimum_mm"), "mm"))),
         ("certified lower bound", lambda s: _e(_quantity(s.get("certified_bound_mm"), "mm"))),
-        ("target (smallest allowed)", lambda s: _e(_quantity(s.get("target_mm"), "mm"))),
-        ("where (carrier angle)", lambda s: _e(_quantity(s.get("carrier_angle_deg"), "deg", 2))),
+        ("target", lambda s: _e("> " + _quantity(s.get("target_mm"), "mm", trim=True))),
+        ("where (carrier angle)",
+         lambda s: _e(_quantity(s.get("carrier_angle_deg"), "deg", 2))),
         ("nearest parts", lambda s: _e(" ↔ ".join(map(str, s.get("nearest") or [])) or "—")),
-        ("nearest points (mm)", lambda s: _e(" ↔ ".join(_point(p) for p in
-                                                        s.get("nearest_points_mm") or []) or "—")),
-        ("interference ranges", lambda s: _e(_degrees_ranges(s.get("interference_ranges_deg")))),
+        ("nearest points (mm)",
+         lambda s: _e(" ↔ ".join(_point(p) for p in s.get("nearest_points_mm") or []) or "—")),
+        ("interference ranges",
+         lambda s: _e(_degrees_ranges(s.get("interference_ranges_deg")))),
         ("kinematic estimate", lambda s: _e(_quantity(s.get("kinematic_estimate_mm"), "mm"))),
         ("evaluations", lambda s: _e(_number(s.get("evaluations")))),
         ("method", lambda s: _e(s.get("method", "—"))),
     )
     rows = [[_e(label)] + [cell(sweeps[n]) for n in names] for label, cell in fields]
-    headers = ["", *(_split_unit(n)[0] for n in names)]
-    body = _table(headers, rows, numeric=tuple(range(1, len(names) + 1)))
+    headers = ["", *(_sweep_name(n, sweeps[n]) for n in names)]
+    body = _table(headers, rows)
     return _section("sweep", "Interference and clearance sweep", body)
 
 
@@ -426,13 +522,15 @@ def _gears_section(report: dict) -> str:
         mesh_rows.append([_e(m["stage"]), _e(" / ".join(m["gears"])),
                           _e(_number(m["centre_distance_mm"])),
                           _e(f"{m['interference_poses']} of {m['poses']}"),
-                          _e(f"{m['overlap_area_max_mm2']:.1e}"), _e(f"{low:.1e}–{high:.1e}"),
-                          _e(f"{m['transmission_error_pp_deg']:.1e}"), _e(relief_text)])
+                          _e(_scientific(m["overlap_area_max_mm2"])),
+                          _e(f"{_scientific(low)}–{_scientific(high)}"),
+                          _e(_scientific(m["transmission_error_pp_deg"])), _e(relief_text)])
         classes.append("fail" if m["interference_poses"] else "")
     if mesh_rows:
         body.append("<h3>Meshes</h3>" + _table(
-            ["stage", "gears", "centre distance (mm)", "interfering poses", "largest overlap (mm²)",
-             "backlash (deg)", "transmission error p-p (deg)", "tip relief"],
+            ["stage", "gears", "centre distance (mm)", "interfering poses",
+             "largest overlap (mm²)", "backlash (deg)", "transmission error p-p (deg)",
+             "tip relief"],
             mesh_rows, numeric=(2, 3, 4, 5, 6), row_classes=classes))
     failures = train.get("failures", [])
     if failures:
@@ -446,8 +544,8 @@ def _cam_section(report: dict) -> str:
         return ""
     state = "pass" if cam.get("cuttable", True) and not cam.get("problems") else "fail"
     shown = {k: v for k, v in cam.items() if k != "problems"}
-    body = (f"<p>{_badge(state)} "
-            f"{'the roller can follow the contour' if state == 'pass' else 'cam problems below'}</p>"
+    verdict = "the roller can follow the contour" if state == "pass" else "cam problems below"
+    body = (f"<p>{_badge(state)} {verdict}</p>"
             + _key_values(shown) + _problem_list(cam.get("problems", [])))
     return _section("cam", "Duckbill cam", body)
 
@@ -467,7 +565,8 @@ def _solids_section(report: dict) -> str:
             f'<code>{_e(assembly.get("file", "—"))}</code> at carrier angle '
             f'{_e(_number(assembly.get("carrier_angle_deg"), trim=True))} deg</p>',
             _table(["part", "kind", "instances", "volume (mm³)", "mass each (kg)",
-                    "centre of mass (mm)", "triangles", "watertight"], rows, numeric=(2, 3, 4, 6))]
+                    "centre of mass (mm)", "triangles", "watertight"], rows,
+                   numeric=(2, 3, 4, 6))]
     enclosure, classes = [], []
     for r in solids.get("enclosure", []):
         ok = r.get("gears_enclosed", True) and r.get("axial_fit", True)
@@ -504,7 +603,7 @@ def _stages_section(report: dict) -> str:
         rows.append(row)
         classes.append("fail" if s.get("status") == "failed" else "")
     total = sum(float(s.get("seconds") or 0.0) for s in stages)
-    rows.append(["<b>total</b>", f"<b>{_e(_number(total))}</b>"] + (["", ""] if with_status else []))
+    rows.append(["<b>total</b>", f"<b>{_e(_number(total))}</b>"] + ["", ""][: 2 * with_status])
     classes.append("")
     headers = ["stage", "seconds"] + (["status", "message"] if with_status else [])
     return _section("stages", "Stages", _table(headers, rows, numeric=(1,), row_classes=classes))
@@ -513,7 +612,8 @@ def _stages_section(report: dict) -> str:
 def _accuracy_section(report: dict) -> str:
     if not report.get("accuracy"):
         return ""
-    return _section("accuracy", "Accuracy achieved", _key_values(report["accuracy"]))
+    # More digits than elsewhere: here the point is how far apart value and bound are.
+    return _section("accuracy", "Accuracy achieved", _key_values(report["accuracy"], digits=9))
 
 
 def _parameters_section(report: dict) -> str:
@@ -543,12 +643,14 @@ def figure_caption(name: str) -> str:
     return words[:1].upper() + words[1:] if words else name
 
 
-def _figure_group(name: str) -> int:
+def _figure_order(name: str) -> tuple:
+    """Sort key: the figure's group, then the first of the group's words it holds, then name."""
     stem = Path(name).stem.lower()
     for index, (_, words) in enumerate(_FIGURE_GROUPS):
-        if any(word in stem for word in words):
-            return index
-    return len(_FIGURE_GROUPS)
+        matches = [k for k, word in enumerate(words) if word in stem]
+        if matches:
+            return index, matches[0], _natural_key(name)
+    return len(_FIGURE_GROUPS), 0, _natural_key(name)
 
 
 def _png_size(data: bytes) -> tuple[int, int] | None:
@@ -571,8 +673,8 @@ def _figures_section(figures: dict) -> str:
     if not figures:
         return ""
     groups: dict[int, list[str]] = {}
-    for name in sorted(figures, key=_natural_key):
-        groups.setdefault(_figure_group(name), []).append(name)
+    for name in sorted(figures, key=_figure_order):
+        groups.setdefault(_figure_order(name)[0], []).append(name)
     parts = []
     for index in sorted(groups):
         title = _FIGURE_GROUPS[index][0] if index < len(_FIGURE_GROUPS) else "Other figures"
@@ -616,11 +718,13 @@ def render_html(report: dict, figures: dict[str, bytes] | None = None) -> str:
         if not isinstance(data, (bytes, bytearray)) or not bytes(data).startswith(_PNG_SIGNATURE):
             raise ValueError(f"figure {name!r} is not PNG data")
         figures[name] = bytes(data)
+    # The verdict's evidence first (targets, then the clearance sweep), then the details.
     if report.get("mechanism") == "pricking":
-        mechanism = [_pricking_section(report)]
+        mechanism = [_pricking_section(report), _sweep_section(report)]
     else:
-        mechanism = [_metrics_section(report), _planting_motion_section(report)]
-    sections = [*mechanism, _sweep_section(report), _gears_section(report), _cam_section(report),
+        mechanism = [_metrics_section(report), _sweep_section(report),
+                     _planting_motion_section(report)]
+    sections = [*mechanism, _gears_section(report), _cam_section(report),
                 _solids_section(report), _figures_section(figures), _stages_section(report),
                 _accuracy_section(report), _parameters_section(report)]
     sections = [s for s in sections if s]

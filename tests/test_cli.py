@@ -101,26 +101,29 @@ def test_help_imports_no_heavy_module(tmp_path):
 
 
 class _FakeResult:
+    exit_code = EXIT_OK
+
     def summary_text(self) -> str:
         return "fake summary"
 
 
 @pytest.fixture
 def fake_analysis(monkeypatch):
-    """Stand-in for cadgen.analyze, recording its calls; feasibility isolated too."""
-    calls = []
-    module = types.ModuleType("cadgen.analyze")
+    """Stand-in for cadgen.build.build, recording its calls; feasibility isolated too."""
+    import cadgen.build
 
-    def run_analysis(params, *, output_root, steps_per_revolution=None):
-        calls.append({"params": params, "output_root": output_root, "steps": steps_per_revolution})
-        if getattr(module, "fail", None):
+    calls = []
+    module = types.SimpleNamespace(fail=None, calls=calls)
+
+    def build(params, *, output_root, effects=None, case=None, steps=None):
+        calls.append({"params": params, "output_root": output_root, "steps": steps,
+                      "effects": effects, "case": case})
+        if module.fail:
             raise module.fail
         return _FakeResult()
 
-    module.run_analysis = run_analysis
-    monkeypatch.setitem(sys.modules, "cadgen.analyze", module)
+    monkeypatch.setattr(cadgen.build, "build", build)
     monkeypatch.setattr(cadgen.feasibility, "design_problems", lambda params: [])
-    module.calls = calls
     return module
 
 
@@ -138,6 +141,21 @@ def test_analyze_defaults(fake_analysis, capsys):
     assert main(["analyze", str(REFERENCE)]) == EXIT_OK
     (call,) = fake_analysis.calls
     assert call["output_root"] == Path("outputs") and call["steps"] is None
+    assert call["effects"] is None and call["case"] is None   # the file's scene decides
+
+
+def test_build_passes_effects_and_case(fake_analysis):
+    assert main(["build", str(REFERENCE), "--effects", "metrics,plots,metrics",
+                 "--case", "bench"]) == EXIT_OK
+    (call,) = fake_analysis.calls
+    assert call["effects"] == ["metrics", "plots"] and call["case"] == "bench"
+
+
+def test_build_rejects_an_unknown_effect(fake_analysis, capsys):
+    with pytest.raises(SystemExit) as caught:
+        main(["build", str(REFERENCE), "--effects", "metrics,meshes"])
+    assert caught.value.code == 2
+    assert "meshes" in capsys.readouterr().err and fake_analysis.calls == []
 
 
 def test_analyze_bad_file_exits_2_without_running(fake_analysis, capsys):

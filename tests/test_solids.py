@@ -13,7 +13,6 @@ import math
 import numpy as np
 import pytest
 
-from cadgen.analyze import _solids_outcome
 from cadgen.cam_design import design_cam
 from cadgen.design import build_mechanism, evaluate, pricking_design, pricking_field
 from cadgen.gear_trains import planting_train, pricking_train
@@ -25,7 +24,7 @@ from cadgen.solids.outline import signed_area
 from cadgen.solids.parts import gear_solid
 from cadgen.solids.planting import planting_assembly
 from cadgen.solids.pricking import pricking_assembly
-from cadgen.solids.stage import solids_report
+from cadgen.solids.stage import solids_outcome as _solids_outcome, solids_report
 from kinematics.errors import DesignError
 
 from helpers import REFERENCE, reference_text

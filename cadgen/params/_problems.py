@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import re
 from collections.abc import Mapping
 from datetime import date, datetime, time
 from typing import Any, Union, get_args, get_origin
@@ -301,8 +302,12 @@ def _problems_from_error(error: Mapping[str, Any], root: Any) -> list[Problem]:
 
     if kind == "literal_error":
         expected = ctx.get("expected")
-        return [Problem(path, "unknown_kind",
-                        f"{name} = {_show(value)} is not allowed: it must be {expected}")]
+        text = f"{name} = {_show(value)} is not allowed: it must be {expected}"
+        choices = re.findall(r"'([^']*)'", str(expected))
+        close = _close_keys(str(value), choices) if isinstance(value, str) else []
+        if close:
+            text += "; did you mean " + " or ".join(f"'{k}'" for k in close) + "?"
+        return [Problem(path, "unknown_kind", text)]
 
     # Not expected from a TOML file; keep pydantic's own words rather than lose the problem.
     return [Problem(path, kind, f"{name}: {error['msg']} (got {_describe(value)})")]

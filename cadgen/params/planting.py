@@ -16,6 +16,7 @@ from pydantic_core import PydanticCustomError
 
 from .cam import CamParameters
 from .cutting import CuttingParameters
+from .scene import SceneParameters
 from .solids import GroundParameters, ShellParameters, SolidsParameters
 from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
@@ -210,3 +211,4 @@ class PlantingParameters(_Table):
     cam: CamParameters = CamParameters()
     ground: GroundParameters = GroundParameters()
     solids: SolidsParameters = SolidsParameters()
+    scene: SceneParameters = SceneParameters()

@@ -18,6 +18,7 @@ from pydantic_core import PydanticCustomError
 
 from ._problems import _close_keys, _describe, _problems_error, _show
 from .cutting import CuttingParameters
+from .scene import SceneParameters
 from .solids import GroundParameters, ShellParameters, SolidsParameters
 from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
@@ -252,4 +253,5 @@ class PrickingParameters(_Table):
     housing: ShellParameters = ShellParameters()
     ground: GroundParameters = GroundParameters()
     solids: SolidsParameters = SolidsParameters()
+    scene: SceneParameters = SceneParameters()
 

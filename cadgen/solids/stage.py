@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SolidsOutcome", "solids_report", "write_solids", "enclosure_checks"]
+__all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "write_solids", "enclosure_checks"]
 
 @dataclass
 class SolidsOutcome:
@@ -23,6 +23,14 @@ class SolidsOutcome:
     carrier_angle: float     # rad, the assembly file's pose
     density: float
     file_type: str
+
+
+def solids_outcome(params, assembly, housings) -> SolidsOutcome:
+    """The solids of a build with their enclosure checks and the file's output settings."""
+    settings = params.solids
+    return SolidsOutcome(assembly, housings, enclosure_checks(assembly, housings),
+                         settings.assembly_carrier_angle_rad, settings.density_kg_m3,
+                         settings.assembly_format)
 
 
 def enclosure_checks(assembly, housings: dict) -> list:

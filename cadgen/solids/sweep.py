@@ -66,6 +66,10 @@ INTERFERENCE_XTOL = 1e-9
 #: Narrowest interval (rad) the interference scan splits where the Lipschitz bound
 #: cannot rule out an overlap; an overlap shorter than this can hide in one.
 INTERFERENCE_RESOLUTION = 1e-6
+#: Covering spheres of a part: 2**depth leaves, on triangles no longer than this
+#: fraction of the part's bounding radius (they only prune pairs: speed, not accuracy).
+_LEAF_DEPTH = 4
+_LEAF_EDGE_FRACTION = 0.25
 #: A point counts as inside a mesh when its winding number exceeds this.
 _WINDING_INSIDE = 0.5
 
@@ -147,16 +151,46 @@ def _winding_numbers(points, triangles):
 
 @dataclass
 class _Shape:
-    """One part mesh as FCL sees it, plus what the containment test needs."""
+    """One part mesh as FCL sees it, plus the bounds that let a query skip it (local frame)."""
 
     model: object              # fcl.BVHModel
-    triangles: np.ndarray      # (n, 3, 3) local frame
-    probes: np.ndarray         # (k, 3) one vertex of each closed surface, local frame
-    centre: np.ndarray         # (3,) bounding sphere, local frame
+    triangles: np.ndarray      # (n, 3, 3)
+    probes: np.ndarray         # (k, 3) one vertex of each closed surface
+    centre: np.ndarray         # (3,) bounding sphere of the whole part
     radius: float
+    leaf_centres: np.ndarray   # (m, 3) spheres that together cover every triangle
+    leaf_radii: np.ndarray     # (m,)
 
 
-def _shape(mesh):
+def _sphere(points):
+    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    return centre, float(np.linalg.norm(points - centre, axis=1).max())
+
+
+def _leaf_spheres(triangles, depth):
+    """Spheres covering the triangles: median splits along the longest extent, ``2**depth`` leaves.
+
+    A sphere holding a triangle's corners holds the triangle, so the spheres'
+    gaps bound the distance between two surfaces from below.
+    """
+    groups = [triangles]
+    for _ in range(depth):
+        split = []
+        for group in groups:
+            if len(group) < 2:
+                split.append(group)
+                continue
+            centroids = group.mean(axis=1)
+            axis = int(np.argmax(np.ptp(centroids, axis=0)))
+            order = np.argsort(centroids[:, axis], kind="stable")
+            half = len(group) // 2
+            split += [group[order[:half]], group[order[half:]]]
+        groups = split
+    spheres = [_sphere(group.reshape(-1, 3)) for group in groups]
+    return np.array([c for c, _ in spheres]), np.array([r for _, r in spheres])
+
+
+def _shape(mesh, depth=_LEAF_DEPTH, edge_fraction=_LEAF_EDGE_FRACTION):
     import fcl
     import trimesh
 
@@ -168,10 +202,14 @@ def _shape(mesh):
     model.endModel()  # without it the first query crashes
     components = trimesh.graph.connected_components(mesh.face_adjacency, nodes=np.arange(len(faces)))
     probes = np.array([vertices[faces[component[0], 0]] for component in components])
-    low, high = vertices.min(axis=0), vertices.max(axis=0)
-    centre = 0.5 * (low + high)
-    radius = float(np.linalg.norm(vertices - centre, axis=1).max())
-    return _Shape(model, vertices[faces], probes, centre, radius)
+    centre, radius = _sphere(vertices)
+    triangles = vertices[faces]
+    # the covering spheres are built on a finer copy: long slivers (the fans of a
+    # prism's caps) would make every leaf sphere as large as the part
+    v, f = trimesh.remesh.subdivide_to_size(vertices, faces, max_edge=edge_fraction * radius)
+    cover = v[f]
+    leaf_centres, leaf_radii = _leaf_spheres(cover, depth)
+    return _Shape(model, triangles, probes, centre, radius, leaf_centres, leaf_radii)
 
 
 # ------------------------------------------------------------------ scene
@@ -204,9 +242,10 @@ class FclScene:
 
     Notes
     -----
-    Pairs are visited nearest bounding spheres first and skipped once their
-    spheres are farther apart than the best distance found, which leaves the
-    minimum unchanged. Only the instances of the two groups are posed.
+    Each part's triangles are covered by a few spheres (median splits); pairs
+    are visited by the gap between their spheres, nearest first, and skipped
+    once that gap (a lower bound) reaches the best distance found, which leaves
+    the minimum unchanged. Only the instances of the two groups are posed.
     """
 
     def __init__(self, assembly, group_a, group_b):
@@ -271,54 +310,62 @@ class FclScene:
             raise SolidInputError("phi", f"carrier angle must be finite, not {phi!r}")
         poses = self._place(phi)
         self.queries += 1
-        spheres = {}
-        for name, pose in poses.items():
-            shape = self._instances[name][3]
-            spheres[name] = (pose[:3, :3] @ shape.centre + pose[:3, 3], shape.radius)
-        gaps = [(float(np.linalg.norm(spheres[a][0] - spheres[b][0])) - spheres[a][1] - spheres[b][1],
-                 a, b) for a, b in self._pairs]
-        gaps.sort(key=lambda g: g[0])
-        best = Proximity(math.inf, np.full(3, np.nan), np.full(3, np.nan), gaps[0][1:])
+        for a, b in self._pairs:   # a solid inside another: no triangles meet, FCL sees a gap
+            point = self._contained(a, b, poses)
+            if point is not None:
+                return Proximity(0.0, point, point.copy(), (a, b))
+        gaps = self._sphere_gaps(poses)
+        best = Proximity(math.inf, np.full(3, np.nan), np.full(3, np.nan), self._pairs[0])
         request = fcl.DistanceRequest(enable_nearest_points=True)
-        for gap, a, b in gaps:
-            if gap >= best.distance:
-                break
+        for index in np.argsort(gaps, kind="stable"):
+            if gaps[index] >= best.distance:
+                break   # no later pair can come closer
+            a, b = self._pairs[index]
             object_a, object_b = self._instances[a][4], self._instances[b][4]
-            # apart bounding spheres cannot overlap; otherwise ask collide first: FCL's
-            # distance of crossing meshes is 0 with meaningless nearest points
-            found = self._overlap(a, b, poses, spheres) if gap <= 0.0 else None
-            if found is not None:
-                return Proximity(0.0, found, found.copy(), (a, b))
+            if gaps[index] <= 0.0:   # covering spheres meet: the triangles may cross
+                contact = fcl.CollisionResult()
+                if fcl.collide(object_a, object_b,
+                               fcl.CollisionRequest(num_max_contacts=1, enable_contact=True), contact):
+                    point = np.array(contact.contacts[0].pos, dtype=float)
+                    return Proximity(0.0, point, point.copy(), (a, b))
             result = fcl.DistanceResult()   # a reused one keeps the old minimum
             d = fcl.distance(object_a, object_b, request, result)
-            if d <= 0.0:   # touching: FCL's nearest points then mean little
-                point = np.asarray(result.nearest_points[0], dtype=float)
+            if d <= 0.0:   # touching without crossing
+                point = np.array(result.nearest_points[0], dtype=float)
                 return Proximity(0.0, point, point.copy(), (a, b))
             if d < best.distance:
                 best = Proximity(float(d), np.array(result.nearest_points[0], dtype=float),
                                  np.array(result.nearest_points[1], dtype=float), (a, b))
         return best
 
-    def _overlap(self, a, b, poses, spheres):
-        """A world point shared by instances ``a`` and ``b``, or None when they do not overlap."""
-        import fcl
+    def _sphere_gaps(self, poses):
+        """Lower bound (mm) of each pair's surface distance, from the covering spheres: (pairs,)."""
+        world = {}
+        for name, pose in poses.items():
+            shape = self._instances[name][3]
+            world[name] = shape.leaf_centres @ pose[:3, :3].T + pose[:3, 3]
+        gaps = np.empty(len(self._pairs))
+        for index, (a, b) in enumerate(self._pairs):
+            centre_gap = np.linalg.norm(world[a][:, None, :] - world[b][None, :, :], axis=-1)
+            radii = self._instances[a][3].leaf_radii[:, None] + self._instances[b][3].leaf_radii[None, :]
+            gaps[index] = float((centre_gap - radii).min())
+        return gaps
 
-        request = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
-        result = fcl.CollisionResult()
-        if fcl.collide(self._instances[a][4], self._instances[b][4], request, result):
-            return np.array(result.contacts[0].pos, dtype=float)
-        # no crossing triangles: one solid may still lie inside the other
+    def _contained(self, a, b, poses):
+        """A world point of ``a`` inside ``b`` or of ``b`` inside ``a``, else None.
+
+        If no triangles of two closed surfaces meet, each of them lies wholly
+        inside or wholly outside the other solid: one vertex per surface decides.
+        """
         for inner, outer in ((a, b), (b, a)):
-            centre, radius = spheres[outer]
             inner_shape, outer_shape = self._instances[inner][3], self._instances[outer][3]
-            pose = poses[inner]
+            pose, outer_pose = poses[inner], poses[outer]
             probes = inner_shape.probes @ pose[:3, :3].T + pose[:3, 3]
-            near = np.linalg.norm(probes - centre, axis=1) <= radius
+            local = (probes - outer_pose[:3, 3]) @ outer_pose[:3, :3]
+            near = np.linalg.norm(local - outer_shape.centre, axis=1) <= outer_shape.radius
             if not near.any():
                 continue
-            outer_pose = poses[outer]
-            local = (probes[near] - outer_pose[:3, 3]) @ outer_pose[:3, :3]
-            inside = _winding_numbers(local, outer_shape.triangles) > _WINDING_INSIDE
+            inside = _winding_numbers(local[near], outer_shape.triangles) > _WINDING_INSIDE
             if inside.any():
                 return probes[near][int(np.argmax(inside))]
         return None

@@ -1,0 +1,337 @@
+"""`cadgen build`: run exactly the stages a scene's effects need, then write the outputs atomically.
+
+A scene (``[scene]`` in the file, or ``effects``/``case`` given here) names the
+effects wanted; :func:`plan` resolves the stages they need, in order, and nothing
+else runs: a scene asking only for ``metrics`` generates no teeth, builds no
+solids and never imports fcl.
+
+Stages (each timed and recorded ``ok``, ``failed`` with the reason, or
+``skipped`` because a stage it needs failed):
+
+==================  ==========================================================
+kinematics          the mechanism (planting: closure; pricking: inverse design)
+metrics             the design metrics (planting) or the field motion (pricking)
+teeth               every gear cut, checked and run through its meshing check
+cam                 the duckbill cam (planting)
+parts               the solids: housings, planter or needle, ground; gears and
+                    the cam plate when those ran; mass and enclosure checks
+arm_interference    FCL sweep of arm against arm (planting)
+ground_clearance    FCL sweep of every housing against the ground
+plots               PNG pictures of what ran
+==================  ==========================================================
+
+Outputs go to a staged folder that replaces ``<output_root>/<name>/`` only when
+everything was written: a failed stage leaves its outputs out and says why in
+the report, and a failure while writing leaves the previous folder untouched.
+Every file but report.json (which holds the stage timings) is byte-identical for
+the same input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from kinematics.errors import ConvergenceError, DesignError, MechanismError
+
+__all__ = ["EFFECT_STAGES", "plan", "BuildResult", "build", "EXIT_OK", "EXIT_CHECKS_FAILED"]
+
+EXIT_OK = 0
+EXIT_CHECKS_FAILED = 1
+
+#: The stages each effect needs (their own needs are added by :func:`plan`).
+EFFECT_STAGES = {
+    "metrics": ("metrics",),
+    "curves": ("kinematics",),
+    "teeth": ("teeth",),
+    "meshing": ("teeth",),      # the meshing check is part of cutting (tip relief needs it)
+    "cam": ("cam",),
+    "solids": ("cam", "parts"),       # gears among the solids when "teeth" runs too
+    "arm_interference": ("cam", "parts", "arm_interference"),
+    "ground_clearance": ("metrics", "parts", "ground_clearance"),
+    "dxf": ("teeth", "cam"),
+    "stl": ("cam", "parts"),
+    "plots": ("plots",),
+    "report": (),
+}
+
+#: Each stage's own needs, and the order stages run in.
+STAGE_NEEDS = {
+    "kinematics": (),
+    "metrics": ("kinematics",),
+    "teeth": ("kinematics",),
+    "cam": ("metrics",),
+    "parts": ("metrics",),
+    "arm_interference": ("parts",),
+    "ground_clearance": ("parts",),
+    "plots": ("kinematics",),
+}
+STAGE_ORDER = tuple(STAGE_NEEDS)
+
+#: Effects with no meaning for a mechanism kind or an operating case (reported, not run).
+NOT_APPLICABLE = {
+    ("pricking", "cam"): "the pricking mechanism has no cam",
+    ("pricking", "arm_interference"): "the pricking mechanism has a single arm",
+    ("bench", "ground_clearance"): "a bench run has no soil",
+}
+
+
+def plan(effects, mechanism: str = "planting", case: str = "field"):
+    """Stages to run for ``effects`` (in run order) and the effects set aside with the reason."""
+    wanted, set_aside = set(), {}
+    for effect in effects:
+        reason = NOT_APPLICABLE.get((mechanism, effect)) or NOT_APPLICABLE.get((case, effect))
+        if reason:
+            set_aside[effect] = reason
+            continue
+        wanted.update(EFFECT_STAGES[effect])
+    if mechanism == "pricking":
+        wanted.discard("cam")
+        wanted.discard("arm_interference")
+    if case == "bench":
+        wanted.discard("ground_clearance")
+    closed = set()
+    stack = list(wanted)
+    while stack:
+        stage = stack.pop()
+        if stage not in closed:
+            closed.add(stage)
+            stack.extend(STAGE_NEEDS[stage])
+    return [s for s in STAGE_ORDER if s in closed], set_aside
+
+
+@dataclass
+class StageRecord:
+    stage: str
+    status: str            # "ok", "failed", "skipped"
+    seconds: float = 0.0
+    message: str = ""
+    problems: list = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        out = {"stage": self.stage, "status": self.status, "seconds": round(self.seconds, 6),
+               "message": self.message}
+        if self.problems:
+            out["problems"] = self.problems
+        return out
+
+
+@dataclass
+class BuildResult:
+    """What a build produced: the report, the folder written and its files."""
+
+    name: str
+    report: dict
+    output_dir: Path | None
+    files: list = field(default_factory=list)
+
+    @property
+    def exit_code(self) -> int:
+        """0 when every stage ran and every target and check passed, else 1."""
+        return EXIT_OK if self.report.get("passed") else EXIT_CHECKS_FAILED
+
+    def summary_text(self) -> str:
+        from .summary import summary_text
+
+        text = summary_text(self.report)
+        return text + (f"\nwrote {len(self.files)} files to {self.output_dir}"
+                       if self.output_dir else "")
+
+
+class _Build:
+    """One build's state: the values each stage made, its records, figures and writers."""
+
+    def __init__(self, params, stages, steps):
+        self.params = params
+        self.stages = stages
+        self.steps = steps
+        self.values: dict = {}
+        self.records: list = []
+        self.figures: dict = {}
+        self.writers: list = []
+
+    def status(self, stage: str) -> str:
+        return next((r.status for r in self.records if r.stage == stage), "not run")
+
+    def run(self, functions: dict) -> None:
+        for stage in self.stages:
+            failed = [need for need in STAGE_NEEDS[stage]
+                      if need in self.stages and self.status(need) != "ok"]
+            if failed:
+                self.records.append(StageRecord(stage, "skipped", message=(
+                    f"needs {', '.join(failed)}, which did not complete")))
+                continue
+            start = time.perf_counter()
+            try:
+                self.values[stage] = functions[stage](self)
+            except (DesignError, ConvergenceError) as error:
+                problems = [{"path": p.path, "code": p.code, "message": p.message}
+                            for p in getattr(error, "problems", [])]
+                message = "; ".join(f"[{p['code']}] {p['message']}" for p in problems) or str(error)
+                self.records.append(StageRecord(stage, "failed", time.perf_counter() - start,
+                                                message, problems))
+                continue
+            except MechanismError as error:
+                self.records.append(StageRecord(stage, "failed", time.perf_counter() - start,
+                                                f"{type(error).__name__}: {error}"))
+                continue
+            self.records.append(StageRecord(stage, "ok", time.perf_counter() - start))
+
+
+# --------------------------------------------------------------------------- stages
+def _kinematics(run):
+    params = run.params
+    if params.mechanism == "pricking":
+        from .design import pricking_design
+
+        return pricking_design(params)
+    from .design import build_mechanism
+
+    mechanism = build_mechanism(params)
+    mechanism.closure   # the closure is solved here, inside its stage
+    return mechanism
+
+
+def _metrics(run):
+    params = run.params
+    if params.mechanism == "pricking":
+        from .design import pricking_field
+
+        return pricking_field(params, run.values["kinematics"])
+    from .design import evaluate
+
+    return evaluate(params, run.values["kinematics"], steps=run.steps)
+
+
+def _teeth(run):
+    from .gear_trains import planting_train, pricking_train
+
+    if run.params.mechanism == "pricking":
+        return pricking_train(run.params, run.values["kinematics"])
+    return planting_train(run.params, run.values["kinematics"])
+
+
+def _cam(run):
+    from .cam_design import design_cam
+
+    return design_cam(run.params, run.values["kinematics"], run.values["metrics"].events)
+
+
+def _parts(run):
+    from .solids.stage import solids_outcome
+
+    params = run.params
+    train = run.values.get("teeth") if run.status("teeth") == "ok" else None
+    if params.mechanism == "pricking":
+        from .solids.pricking import pricking_assembly
+
+        assembly, housings = pricking_assembly(params, run.values["kinematics"], train,
+                                               run.values["metrics"])
+        return solids_outcome(params, assembly, housings)
+    from .solids.planting import planting_assembly
+
+    cam = run.values.get("cam") if run.status("cam") == "ok" else None
+    assembly, housings, _ = planting_assembly(params, run.values["kinematics"], train, cam,
+                                              run.values["metrics"].events.soil_level)
+    return solids_outcome(params, assembly, {"gearbox1": housings[0], "gearbox2": housings[1]})
+
+
+def _arm_interference(run):
+    from .clearances import arm_interference
+
+    return arm_interference(run.params, run.values["kinematics"], run.values["parts"],
+                            run.values.get("cam"))
+
+
+def _ground_clearance(run):
+    from .clearances import ground_clearance
+
+    return ground_clearance(run.params, run.values["kinematics"], run.values["parts"],
+                            run.values["metrics"])
+
+
+def _plots(run):
+    from .figures import build_figures
+
+    return build_figures(run)
+
+
+STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "teeth": _teeth, "cam": _cam,
+                   "parts": _parts, "arm_interference": _arm_interference,
+                   "ground_clearance": _ground_clearance, "plots": _plots}
+
+
+# --------------------------------------------------------------------------- the build
+def build(params, output_root: Path | str | None = Path("outputs"), *, effects=None,
+          case: str | None = None, steps: int | None = None) -> BuildResult:
+    """Build one validated design: the stages its effects need, then its outputs.
+
+    Parameters
+    ----------
+    params : PlantingParameters or PrickingParameters
+        Validated (see :func:`cadgen.params.load_params`).
+    output_root : path or None
+        Outputs go to ``<output_root>/<name>/``, atomically; ``None`` writes nothing.
+    effects : sequence of str, optional
+        Overrides the file's ``scene.effects``.
+    case : {"field", "bench"}, optional
+        Overrides the file's ``scene.case``.
+    steps : int, optional
+        Overrides ``resolution.steps_per_revolution`` (planting).
+    """
+    scene = params.scene
+    effects = tuple(effects) if effects is not None else scene.effects
+    case = case or scene.case
+    stages, set_aside = plan(effects, params.mechanism, case)
+    run = _Build(params, stages, steps)
+    run.effects, run.case = effects, case
+    run.run(STAGE_FUNCTIONS)
+    from .report_build import assemble_report
+
+    report = assemble_report(run, set_aside)
+    run.report = report
+    if output_root is None:
+        return BuildResult(params.name, report, None)
+    return _write(run, Path(output_root) / params.name)
+
+
+def _write(run, final: Path) -> BuildResult:
+    from .atomic import staged_directory
+    from .writers import writers_for
+
+    report = run.report
+    files = []
+    with staged_directory(final) as staging:
+        for writer in writers_for(run):
+            files += [str(path) for path in writer(staging)]
+        if run.figures:
+            (staging / "plots").mkdir(exist_ok=True)
+            for name, data in run.figures.items():
+                (staging / "plots" / name).write_bytes(data)
+                files.append(f"plots/{name}")
+        files.append("report.json")
+        if "report" in run.effects:
+            from .report_html import render_html
+
+            (staging / "report.html").write_text(render_html(report, run.figures),
+                                                 encoding="utf-8")
+            files.append("report.html")
+        report["files"] = sorted(files)
+        (staging / "report.json").write_text(
+            json.dumps(report, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+    return BuildResult(run.params.name, report, final, sorted(files))
+
+
+def _jsonable(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")

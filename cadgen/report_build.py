@@ -1,0 +1,192 @@
+"""The build's report: parameters, metrics against targets, checks, stages, versions, hash."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import platform
+
+import numpy as np
+
+__all__ = ["input_hash", "report_dict", "assemble_report"]
+
+
+def input_hash(params) -> str:
+    """SHA-256 of the validated parameters in canonical JSON (same design, same hash)."""
+    canonical = json.dumps(params.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+def _versions() -> dict:
+    import scipy
+
+    from . import __version__
+
+    return {"cadgen": __version__, "python": platform.python_version(),
+            "numpy": np.__version__, "scipy": scipy.__version__}
+
+
+def report_dict(params, mechanism, evaluation, case: str = "field") -> dict:
+    """The planting metrics' sections: metrics against targets, events, derived geometry, accuracy.
+
+    A bench run has no soil: the metrics that need it (holes, entry/exit attitude,
+    ground clearance, absolute speeds) are left out.
+    """
+    closure = mechanism.closure
+    ratio_1, ratio_2 = mechanism.converted_ratios
+    events = evaluation.events
+    per_spacing = []
+    for hole in evaluation.holes:
+        s = hole.spacing
+        per_spacing.append({
+            "spacing_mm": s, "hole_width_mm": hole.width, "hole_verticality_mm": hole.verticality,
+            "hole_span_mm": hole.span, "x_entry_mm": hole.x_entry, "x_exit_mm": hole.x_exit,
+            "x_lowest_mm": hole.x_lowest,
+            "tip_velocity_absolute_lowest_mm_s": evaluation.speeds["absolute_lowest"][s],
+            "tip_velocity_absolute_catching_mm_s": evaluation.speeds["absolute_catching"][s],
+        })
+    metrics = [{"key": m.key, "label": m.label, "value": m.value, "unit": m.unit,
+                "target": m.target, "passed": m.passed, "spacing_mm": m.spacing}
+               for m in evaluation.metrics
+               if case == "field" or m.key not in FIELD_METRICS]
+    return {
+        "metrics": metrics,
+        "per_spacing": per_spacing,
+        "events": {
+            "carrier_angle_deg": {"catching": 0.0, "entry": math.degrees(events.entry),
+                                  "lowest": math.degrees(events.lowest),
+                                  "exit": math.degrees(events.exit)},
+            "attitude_deg": evaluation.attitudes_deg,
+            "tip_height_mm": {"catching": events.lowest_height + evaluation.catch_to_plant_height,
+                              "lowest": events.lowest_height, "highest": events.highest_height},
+            "soil_level_mm": events.soil_level,
+            "catch_to_plant_height_mm": evaluation.catch_to_plant_height,
+            "soil_penetrations": events.penetrations,
+            "tip_velocity_relative_lowest_mm_s": evaluation.speeds["relative_lowest"],
+            "tip_velocity_relative_catching_mm_s": evaluation.speeds["relative_catching"],
+            "carrier_speed_rpm": evaluation.carrier_speed_rpm,
+        },
+        "derived": {
+            "centre_distance_a_mm": closure.centre_distance,
+            "carrier_radii_mm": mechanism.carrier_radii,
+            "path_height_of_E_mm": mechanism.path_height_of_E(),
+            "pitch_radius_min_mm": closure.radius_min[1],
+            "pitch_radius_max_mm": closure.radius_max[1],
+            "intermediate_radius_min_mm": closure.centre_distance - closure.radius_max[1],
+            "ratio_min": closure.ratio_min, "ratio_max": closure.ratio_max,
+            "pitch_perimeter_mm": evaluation.perimeter,
+            "module_mm": evaluation.module,
+            "converted_ratios_train1": {"gearbox2_set": ratio_1, "central_gear_set": ratio_2},
+            "arm_distance_at_deg": evaluation.arm_distance_at_deg,
+            "ground_clearance_at_deg": evaluation.extras["ground_clearance_at_deg"],
+            "ground_clearance_nearest": f"{evaluation.ground_clearance_circle.gearbox} at "
+                                        f"{evaluation.ground_clearance_circle.point}",
+            "housing_circles_mm": [{"gearbox": c.gearbox, "axis": c.point, "radius": c.radius}
+                                   for c in evaluation.housing_circles],
+            "clearance_method": evaluation.extras["clearance_method"],
+        },
+        "accuracy": evaluation.accuracy,
+    } if case == "field" else {
+        "metrics": metrics,
+        "derived": {"centre_distance_a_mm": closure.centre_distance,
+                    "pitch_perimeter_mm": evaluation.perimeter, "module_mm": evaluation.module,
+                    "ratio_min": closure.ratio_min, "ratio_max": closure.ratio_max,
+                    "arm_distance_at_deg": evaluation.arm_distance_at_deg},
+        "accuracy": evaluation.accuracy,
+    }
+
+
+#: Metrics that need the soil: not evaluated on a bench run.
+FIELD_METRICS = {"hole_width", "hole_verticality", "angle_difference", "ground_clearance",
+                 "soil_penetrations"}
+
+
+def _header(params, run) -> dict:
+    return {"design": params.name, "mechanism": params.mechanism,
+            "input_sha256": input_hash(params),
+            "scene": {"case": run.case, "effects": list(run.effects)}}
+
+
+def assemble_report(run, set_aside: dict) -> dict:
+    """The whole report of a build from what its stages made (sections only for stages that ran)."""
+    params = run.params
+    report = _header(params, run)
+    report["scene"]["set_aside"] = dict(set_aside)
+    values = run.values
+    ok = {r.stage for r in run.records if r.status == "ok"}
+    if params.mechanism == "pricking" and {"kinematics", "metrics"} <= ok:
+        from .pricking_report import pricking_report
+
+        report.update(pricking_report(params, values["kinematics"], values["metrics"]))
+    elif params.mechanism == "planting" and "metrics" in ok:
+        report.update(report_dict(params, values["kinematics"], values["metrics"], run.case))
+    if "teeth" in ok:
+        from .gear_trains import train_report
+
+        report["gear_train"] = train_report(values["teeth"])
+    if "cam" in ok:
+        from .cam_design import cam_section
+
+        report["cam"] = cam_section(values["cam"])
+    if "parts" in ok:
+        from .solids.stage import solids_report
+
+        report["solids"] = solids_report(values["parts"])
+    sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
+    if sweeps:
+        report["sweep"] = sweeps
+        _replace_kinematic_estimates(report, sweeps)
+    report["stages"] = [record.as_dict() for record in run.records]
+    report["failures"] = failures(report)
+    report["passed"] = not report["failures"]
+    report["versions"] = _versions()
+    report["parameters"] = params.model_dump(mode="json")
+    return report
+
+
+def _replace_kinematic_estimates(report: dict, sweeps: dict) -> None:
+    """The solids' clearances stand for the metrics; the kinematic estimates stay beside them."""
+    for metric in report.get("metrics", []):
+        sweep = sweeps.get({"arm_distance": "arm_interference",
+                            "ground_clearance": "ground_clearance"}.get(metric["key"], ""))
+        if sweep:
+            metric["kinematic_estimate"] = metric["value"]
+            metric["value"] = sweep["minimum_mm"]
+            metric["label"] = sweep["label"]
+            metric["passed"] = sweep["passed"]
+
+
+def failures(report: dict) -> list:
+    """Every reason the design does not pass, one sentence each (empty: it passes)."""
+    out = []
+    for metric in report.get("metrics", []):
+        if not metric["passed"]:
+            where = f" at {metric['spacing_mm']:g} mm" if metric.get("spacing_mm") else ""
+            out.append(f"{metric['label']}{where}: {metric['value']:.3f} {metric['unit']} "
+                       f"(target {metric['target']} {metric['unit']})".replace("  ", " "))
+    for finding in report.get("findings", []):
+        out.append(f"[{finding['code']}] {finding['message']}")
+    gear_train = report.get("gear_train", {})
+    for failure in gear_train.get("failures", []):
+        out.append(f"[{failure['code']}] {failure['message']}")
+    for mesh in gear_train.get("meshes", []):
+        if mesh["interference_poses"]:
+            out.append(f"mesh {mesh['stage']}: {mesh['interference_poses']} interfering poses")
+    for problem in report.get("cam", {}).get("problems", []):
+        out.append(f"[{problem['code']}] {problem['message']}")
+    for row in report.get("solids", {}).get("enclosure", []):
+        if not row["gears_enclosed"]:
+            out.append(f"{row['housing']} does not enclose its gears (margin "
+                       f"{row['smallest_margin_mm']:.2f} mm at {row['nearest_gear']})")
+    for key, sweep in report.get("sweep", {}).items():
+        if sweep.get("interference_ranges_deg"):
+            out.append(f"{sweep['label']}: interference over "
+                       + ", ".join(f"{a:.1f}..{b:.1f} deg" for a, b in
+                                   sweep["interference_ranges_deg"]))
+    for record in report.get("stages", []):
+        if record["status"] != "ok":
+            out.append(f"stage {record['stage']} {record['status']}: {record['message']}")
+    return out
+
+

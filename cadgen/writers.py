@@ -1,0 +1,90 @@
+"""The files a build writes, each from the stages that ran and the effects asked for.
+
+Each writer takes the staging folder and returns the paths it wrote, relative
+to it (see :func:`cadgen.build.build`, which runs them inside the staged,
+atomic output folder).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["writers_for"]
+
+
+def writers_for(run) -> list:
+    """The writers of a finished run: curves (CSV), DXF (gears, cam), STL and the assembly."""
+    ok = {r.stage for r in run.records if r.status == "ok"}
+    effects = set(run.effects)
+    writers = []
+    if "curves" in effects and "kinematics" in ok:
+        writers.append(lambda staging: _write_curves(run, staging))
+    if "dxf" in effects:
+        if "teeth" in ok and run.values["teeth"].stages:
+            writers.append(lambda staging: _write_gears(run, staging))
+        if "cam" in ok and run.values["cam"].cuttable:
+            writers.append(lambda staging: _write_cam(run, staging))
+    if "stl" in effects and "parts" in ok:
+        from .solids.stage import write_solids
+
+        writers.append(lambda staging: write_solids(run.values["parts"], staging))
+    return writers
+
+
+def _write_gears(run, staging):
+    from .gear_trains import write_train_files
+
+    (staging / "gears").mkdir()
+    return [f"gears/{Path(path).name}" for path in
+            write_train_files(run.values["teeth"], staging / "gears",
+                              run.params.gears.chord_tolerance)]
+
+
+def _write_cam(run, staging):
+    from .export_dxf import write_cam_dxf
+
+    params, design = run.params, run.values["cam"]
+    points = params.cam.profile_points
+    write_cam_dxf(staging / "cam.dxf", design.profile.working_profile(points),
+                  design.profile.pitch_curve(points), bore_radius=params.cam.bore_diameter / 2,
+                  chord_tolerance=params.gears.chord_tolerance)
+    return ["cam.dxf"]
+
+
+#: Samples per turn of each tabulated pitch curve.
+CURVE_SAMPLES = 3600
+
+
+def _write_curves(run, staging):
+    """The non-circular gears' pitch curves, tabulated in polar form for manufacture (CSV)."""
+    folder = staging / "curves"
+    folder.mkdir()
+    written = []
+    for name, (angle, radius) in _pitch_tables(run).items():
+        order = np.argsort(np.mod(angle, 2 * np.pi))
+        rows = np.column_stack([np.degrees(np.mod(angle, 2 * np.pi))[order], radius[order]])
+        text = "polar_angle_deg,radius_mm\n" + "".join(f"{a:.9f},{r:.9f}\n" for a, r in rows)
+        path = folder / f"{name.replace(' ', '-')}.csv"
+        path.write_text(text, encoding="utf-8")
+        written.append(f"curves/{path.name}")
+    return written
+
+
+def _pitch_tables(run) -> dict:
+    """``{gear: (polar angle rad, radius mm)}`` of every non-circular gear over one turn."""
+    if run.params.mechanism == "pricking":
+        design = run.values["kinematics"]
+        v = np.linspace(0.0, design.motion.period, CURVE_SAMPLES, endpoint=False)
+        tables = {}
+        for name, functions in design.pitch_functions.items():
+            rho, _, psi, _ = functions(v)
+            tables[name] = (psi, rho)
+        return tables
+    from .gear_trains import planting_pair
+
+    pair = planting_pair(run.values["kinematics"])
+    tau = np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES, endpoint=False)
+    return {name: (functions(tau)[2], functions(tau)[0])
+            for name, functions in zip(pair.names, (pair.drive, pair.driven))}

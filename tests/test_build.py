@@ -1,0 +1,139 @@
+"""`cadgen build`: scenes run exactly the stages their effects need; outputs atomic, deterministic."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+import cadgen.build
+from cadgen.build import build, plan
+from cadgen.cli import EXIT_CHECKS_FAILED, EXIT_OK, main
+from cadgen.params import load_params
+from kinematics.errors import DesignError, Problem
+
+from helpers import REFERENCE, edited
+
+KERNEL_A = REFERENCE.parent / "kernel-a.toml"
+
+
+@pytest.fixture(scope="module")
+def params():
+    return load_params(REFERENCE)
+
+
+@pytest.mark.parametrize("effects, stages", [
+    (["metrics"], ["kinematics", "metrics"]),
+    (["curves"], ["kinematics"]),
+    (["teeth"], ["kinematics", "teeth"]),
+    (["cam"], ["kinematics", "metrics", "cam"]),
+    (["dxf"], ["kinematics", "metrics", "teeth", "cam"]),
+    (["arm_interference"], ["kinematics", "metrics", "cam", "parts", "arm_interference"]),
+    (["ground_clearance"], ["kinematics", "metrics", "parts", "ground_clearance"]),
+    (["plots"], ["kinematics", "plots"]),
+])
+def test_each_effect_needs_exactly_its_stages(effects, stages):
+    assert plan(effects)[0] == stages
+
+
+def test_effects_without_meaning_are_set_aside_with_the_reason():
+    stages, aside = plan(["cam", "arm_interference", "metrics"], mechanism="pricking")
+    assert stages == ["kinematics", "metrics"] and set(aside) == {"cam", "arm_interference"}
+    stages, aside = plan(["ground_clearance"], case="bench")
+    assert stages == [] and "soil" in aside["ground_clearance"]
+
+
+def test_a_metrics_scene_builds_no_teeth_no_solids_and_never_imports_fcl(tmp_path):
+    """In a fresh interpreter: the heavy libraries of the later stages stay unimported."""
+    script = (
+        "import sys\n"
+        "from cadgen.cli import main\n"
+        f"code = main(['build', {str(REFERENCE)!r}, '--effects', 'metrics', '--output-dir', "
+        f"{str(tmp_path)!r}])\n"
+        "heavy = [m for m in ('fcl', 'manifold3d', 'trimesh', 'matplotlib', 'ezdxf') "
+        "if m in sys.modules]\n"
+        "print('HEAVY', heavy, 'CODE', code)\n")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         check=True).stdout
+    assert "HEAVY [] CODE 0" in out
+    report = json.loads((tmp_path / "xin2024-planter" / "report.json").read_text())
+    assert [s["stage"] for s in report["stages"]] == ["kinematics", "metrics"]
+    assert "gear_train" not in report and "solids" not in report
+    assert sorted(p.name for p in (tmp_path / "xin2024-planter").iterdir()) == ["report.json"]
+
+
+def test_bench_run_reports_only_what_needs_no_soil(params):
+    result = build(params, None, effects=["metrics"], case="bench")
+    keys = {m["key"] for m in result.report["metrics"]}
+    assert keys == {"trajectory_height", "arm_distance", "module"}
+    assert result.report["scene"]["case"] == "bench" and result.report["passed"]
+
+
+def test_a_failed_stage_is_reported_its_dependents_skipped_the_rest_written(
+        params, tmp_path, monkeypatch):
+    def broken(run):
+        raise DesignError([Problem("cam.roller_radius", "synthetic", "the cam stage broke")])
+
+    monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, "cam", broken)
+    result = build(params, tmp_path, effects=["metrics", "cam", "curves", "dxf"])
+    stages = {s["stage"]: s for s in result.report["stages"]}
+    assert stages["cam"]["status"] == "failed" and "the cam stage broke" in stages["cam"]["message"]
+    assert stages["cam"]["problems"][0]["path"] == "cam.roller_radius"
+    assert stages["teeth"]["status"] == "ok"
+    assert not result.report["passed"] and result.exit_code == EXIT_CHECKS_FAILED
+    folder = tmp_path / "xin2024-planter"
+    assert (folder / "gears" / "central.dxf").is_file() and not (folder / "cam.dxf").exists()
+    assert any("stage cam failed" in f for f in result.report["failures"])
+
+
+def test_a_failure_while_writing_leaves_the_previous_outputs(params, tmp_path, monkeypatch):
+    build(params, tmp_path, effects=["metrics"])
+    before = (tmp_path / "xin2024-planter" / "report.json").read_bytes()
+    import cadgen.writers
+
+    def failing(run):
+        def write(staging):
+            (staging / "half.txt").write_text("half")
+            raise RuntimeError("disk full")
+        return [write]
+
+    monkeypatch.setattr(cadgen.writers, "writers_for", failing)
+    with pytest.raises(RuntimeError):
+        build(params, tmp_path, effects=["metrics", "curves"])
+    assert (tmp_path / "xin2024-planter" / "report.json").read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["xin2024-planter"]
+    assert not (tmp_path / "xin2024-planter" / "half.txt").exists()
+
+
+def test_pitch_curve_tables_close_on_the_spec_perimeter(params, tmp_path):
+    """curves/central.csv is the polar pitch curve: its perimeter is the spec's 192.886 mm."""
+    import numpy as np
+
+    build(params, tmp_path, effects=["curves"])
+    table = np.loadtxt(tmp_path / "xin2024-planter" / "curves" / "central.csv", delimiter=",",
+                       skiprows=1)
+    angle, radius = np.radians(table[:, 0]), table[:, 1]
+    points = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+    perimeter = np.linalg.norm(np.diff(np.vstack([points, points[:1]]), axis=0), axis=1).sum()
+    assert perimeter == pytest.approx(192.886, abs=2e-3)
+
+
+def test_exit_codes_say_whether_the_design_passes(tmp_path, capsys):
+    passing = main(["build", str(REFERENCE), "--effects", "metrics", "--output-dir",
+                    str(tmp_path)])
+    strict = tmp_path / "strict.toml"
+    strict.write_text(edited(module_min="3.0"))
+    failing = main(["build", str(strict), "--effects", "metrics", "--output-dir", str(tmp_path)])
+    assert (passing, failing) == (EXIT_OK, EXIT_CHECKS_FAILED)
+    assert "non-circular gear module" in capsys.readouterr().out
+
+
+def test_pricking_build_runs_its_own_stages(tmp_path):
+    result = build(load_params(KERNEL_A), tmp_path, effects=["metrics", "cam", "curves"])
+    assert [s["stage"] for s in result.report["stages"]] == ["kinematics", "metrics"]
+    assert result.report["scene"]["set_aside"] == {"cam": "the pricking mechanism has no cam"}
+    curves = sorted(p.name for p in (tmp_path / "kernel-a" / "curves").iterdir())
+    assert curves == ["intermediate-1.csv", "intermediate-2.csv", "planet.csv", "sun.csv"]
+    # kernel-a's gears are concave: the design does not pass, and says why
+    assert not result.report["passed"]
+    assert any("concave" in f for f in result.report["failures"])

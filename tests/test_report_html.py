@@ -1,0 +1,375 @@
+"""report_html: one self-contained, deterministic HTML page per design report."""
+
+import base64
+import copy
+import html
+import importlib.util
+import io
+import re
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from cadgen.analyze import run_analysis
+from cadgen.params import load_params
+from cadgen.report_html import figure_caption, overall_checks, render_html, write_html
+from tests.helpers import REFERENCE
+
+VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source",
+        "track", "wbr"}
+
+
+class _StrictParser(HTMLParser):
+    """Collects structural errors html.parser itself tolerates: unclosed or crossed tags."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.stack, self.errors, self.tags = [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append((tag, dict(attrs)))
+        if tag not in VOID:
+            self.stack.append(tag)
+
+    def handle_startendtag(self, tag, attrs):
+        self.tags.append((tag, dict(attrs)))
+
+    def handle_endtag(self, tag):
+        if not self.stack or self.stack[-1] != tag:
+            self.errors.append(f"</{tag}> closes {self.stack[-1:] or 'nothing'}")
+        else:
+            self.stack.pop()
+
+
+def parse(page: str) -> _StrictParser:
+    parser = _StrictParser()
+    parser.feed(page)
+    parser.close()
+    assert parser.errors == [] and parser.stack == [], (parser.errors, parser.stack)
+    return parser
+
+
+def section(page: str, anchor: str) -> str:
+    match = re.search(rf'<section id="{anchor}">(.*?)</section>', page, re.S)
+    assert match, f"no section {anchor!r}"
+    return match[1]
+
+
+def rows(fragment: str) -> list[list[str]]:
+    """Text of the cells of every table row (not for rows holding nested tables)."""
+    return [[html.unescape(re.sub(r"<[^>]+>", "", cell)).strip()
+             for cell in re.findall(r"<t[dh][^>]*>(.*?)</t[dh]>", row, re.S)]
+            for row in re.findall(r"<tr[^>]*>(.*?)</tr>", fragment, re.S)]
+
+
+def tiny_png(seed: int) -> bytes:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(1.0, 0.8), dpi=40)
+    FigureCanvasAgg(figure)
+    figure.add_subplot().plot([0, 1, 2], [seed, 0, seed * 2])
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", metadata={"Software": None})
+    return buffer.getvalue()
+
+
+@pytest.fixture(scope="module")
+def planting():
+    params = load_params(REFERENCE)
+    # No cam: it would bring the tooth-cutting stage along (seconds); CAM below stands in.
+    return run_analysis(params, output_root=None, plots=False, gears=False, cam=False,
+                        solids=False).report
+
+
+@pytest.fixture(scope="module")
+def figures():
+    names = ["clearance.png", "gears-2-train-1.png", "attitude.png", "cam-contour.png",
+             "gears-10-last.png", "assembly.png", "mystery.png", "pitch_curves.png"]
+    return {name: tiny_png(k + 1) for k, name in enumerate(names)}
+
+
+def sweep_entry(minimum, passed, ranges):
+    return {"method": "swept solids", "minimum_mm": minimum, "certified_bound_mm": minimum - 0.25,
+            "carrier_angle_deg": 83.5, "nearest": ["gearbox2", "ground"],
+            "nearest_points_mm": [[1.0, 2.0, 3.0], [4.0, 5.5, 6.0]],
+            "interference_ranges_deg": ranges, "kinematic_estimate_mm": minimum + 1.5,
+            "target_mm": 20.0, "passed": passed, "evaluations": 977}
+
+
+PRICKING = {
+    "design": "kernel-x", "mechanism": "pricking", "input_sha256": "ab" * 32, "verified": True,
+    "findings": [{"path": "gears.planet", "code": "undercut",
+                  "message": "the planet gear's pitch curve bends below 17.10 mm"}],
+    "linkage": {"centre_distance_a_mm": 51.87, "carrier_sense": "clockwise"},
+    "gears": {"teeth": [26, 26], "pitch_curves": [
+        {"name": "sun", "stage": 1, "role": "drive", "perimeter_mm": 163.36, "radius_min_mm": 23.9,
+         "radius_max_mm": 27.6, "curvature_min_per_mm": 0.0225, "convex": True,
+         "pressure_angle_deviation_max_deg": 10.7, "convex_radius_of_curvature_min_mm": 20.4,
+         "undercut": False}]},
+    "verification": {"forward_deviation_mm": 1.3e-8, "grid_closure_error_rad": 3.7e-12},
+    "field": {"carrier_speed_rpm": 75.0, "forward_speed_mm_s": 530.0, "depth_mm": 70.0,
+              "angles": "carrier progress in deg", "per_inclination": [
+                  {"inclination_deg": incl, "needle_entry_angle_deg": 82.5 - incl / 10,
+                   "needle_exit_angle_deg": 72.25, "hole_mouth_mm": 23.5 + incl,
+                   "mouth_x_range_mm": [394.0, 417.5], "time_in_soil_deg": 139.125,
+                   "slow_windows_deg": [[32.5, 85.0]], "slow_window_total_deg": 52.5,
+                   "projected_height_mm": 214.5, "width_mm": 246.75,
+                   "needle_root_in_soil": incl > 30} for incl in (6.5, 33.5)]},
+    "stages_s": {"inverse_design": 0.5, "field": 0.25},
+    "versions": {"cadgen": "0.1.0"},
+}
+
+GEAR_TRAIN = {
+    "gears": [{"gear": "sun", "stage": "stage 1", "teeth": 26, "module_mm": 2.0, "cutter": "rack",
+               "shaper_teeth": None, "convex": True, "undercut_teeth": [5, 6],
+               "pointed_teeth": [], "root_thickness_min_mm": 3.1415, "tip_thickness_min_mm": 1.375,
+               "problems": [{"code": "undercut", "message": "teeth 5, 6 are undercut"}]}],
+    "meshes": [{"stage": "stage 1", "gears": ["sun", "planet"], "centre_distance_mm": 51.87,
+                "poses": 208, "interference_poses": 0, "overlap_area_max_mm2": 0.0,
+                "backlash_deg": [1e-4, 2.5e-4], "transmission_error_pp_deg": 2.2e-4,
+                "tip_relief": None}],
+    "failures": [{"stage": "stage 2", "path": "gears.planet", "code": "gear_not_cuttable",
+                  "message": "the planet gear cannot be cut"}],
+}
+
+SOLIDS = {
+    "density_kg_m3": 7850.0, "total_mass_kg": 1.625,
+    "parts": [{"part": "gear-case", "kind": "housing", "instances": 1, "volume_mm3": 191772.6,
+               "mass_kg": 1.5054, "centre_of_mass_mm": [-1.84, -3e-15, 15.0], "triangles": 776,
+               "watertight": True}],
+    "assembly": {"file": "solids/assembly.glb", "carrier_angle_deg": 0.0},
+    "enclosure": [{"housing": "gear-case", "gears_enclosed": False, "smallest_margin_mm": -0.75,
+                   "nearest_gear": "sun", "axial_fit": True}],
+}
+
+CAM = {"opening_angle_deg": 13.75, "mouth_mm": 40.0, "cuttable": False, "roller_radius_mm": 6.0,
+       "carrier_angle_deg": {"opening": [183.25, 213.25], "lowest": 188.25},
+       "laws": {"opening": "cycloidal"},
+       "problems": [{"code": "roller_too_large",
+                     "message": "the roller radius 6 mm exceeds the convex pitch radius 5.5 mm"}]}
+
+
+@pytest.mark.parametrize("kind", ["planting", "pricking"])
+def test_page_is_well_formed(kind, planting, figures):
+    report = planting if kind == "planting" else PRICKING
+    page = render_html(report, figures)
+    assert page.startswith("<!DOCTYPE html>\n")
+    tags = [tag for tag, _ in parse(page).tags]
+    assert tags.count("html") == tags.count("body") == tags.count("style") == 1
+    assert report["design"] in page and report["input_sha256"] in page
+
+
+def test_every_metric_label_and_value_is_shown(planting):
+    table = rows(section(render_html(planting, {}), "metrics"))
+    assert table[0] == ["metric", "plant spacing", "value", "target", "result"]
+    expected = [[m["label"], "" if m["spacing_mm"] is None else f"{m['spacing_mm']:g} mm",
+                 f"{m['value']:.3f} {m['unit']}".strip(), f"{m['target']} {m['unit']}".strip(),
+                 "PASS"] for m in planting["metrics"]]
+    assert table[1:] == expected
+    assert len(expected) >= 10
+
+
+def test_failing_metric_is_marked_fail(planting):
+    report = copy.deepcopy(planting)
+    report["metrics"][2]["passed"] = False
+    report["passed"] = False
+    page = render_html(report, {})
+    body = section(page, "metrics")
+    row_html = re.findall(r"<tr[^>]*>.*?</tr>", body, re.S)[1:]
+    assert 'class="fail"' in row_html[2] and ">FAIL<" in row_html[2]
+    assert all(">PASS<" in r for k, r in enumerate(row_html) if k != 2)
+    assert 'verdict fail">FAIL<' in page
+    assert 'verdict pass">PASS<' in render_html(planting, {})
+
+
+def test_figures_are_embedded_byte_for_byte_in_groups(planting, figures):
+    page = render_html(planting, figures)
+    images = [attrs for tag, attrs in parse(page).tags if tag == "img"]
+    assert len(images) == len(figures)
+    by_alt = {attrs["alt"]: attrs["src"] for attrs in images}
+    for name, data in figures.items():
+        src = by_alt[figure_caption(name)]
+        assert src.startswith("data:image/png;base64,")
+        assert base64.b64decode(src.split(",", 1)[1], validate=True) == data
+        assert f"<code>{name}</code>" in page
+    order = [re.search(r"<code>([^<]+\.png)</code>", f)[1]
+             for f in re.findall(r"<figure>.*?</figure>", page, re.S)]
+    assert order == ["attitude.png", "pitch_curves.png", "gears-2-train-1.png",
+                     "gears-10-last.png", "cam-contour.png", "assembly.png", "clearance.png",
+                     "mystery.png"]
+
+
+def test_no_external_references(planting, figures):
+    report = copy.deepcopy(planting)
+    report["sweep"] = {"ground_clearance": sweep_entry(25.0, True, [])}
+    for page in (render_html(report, figures), render_html(PRICKING, figures)):
+        assert "http://" not in page and "https://" not in page
+        assert "<script" not in page and "<link" not in page and "<iframe" not in page
+        assert "url(" not in page and "@import" not in page
+        for tag, attrs in parse(page).tags:
+            for key in ("src", "href"):
+                if key in attrs:
+                    value = attrs[key]
+                    assert value.startswith(("#", "data:image/png;base64,")), (tag, value)
+                    assert "//" not in value.split(",", 1)[0]
+
+
+def test_sweep_section_when_present(planting):
+    assert '<section id="sweep">' not in render_html(planting, {})
+    report = copy.deepcopy(planting)
+    report["sweep"] = {"arm_distance": sweep_entry(111.25, True, []),
+                       "ground_clearance": dict(sweep_entry(-3.5, False, [[170.5, 189.5],
+                                                                          [350.0, 359.5]]),
+                                                label="ground clearance (solids)")}
+    page = render_html(report, {})
+    table = {row[0]: row[1:] for row in rows(section(page, "sweep"))}
+    assert table[""] == ["arm distance", "ground clearance (solids)"]
+    assert table["result"] == ["PASS", "FAIL"]
+    assert table["minimum"] == ["111.250 mm", "-3.500 mm"]
+    assert table["certified lower bound"] == ["111.000 mm", "-3.750 mm"]
+    assert table["target"] == ["> 20 mm", "> 20 mm"]
+    assert table["where (carrier angle)"] == ["83.50 deg", "83.50 deg"]
+    assert table["nearest parts"] == ["gearbox2 ↔ ground"] * 2
+    assert table["interference ranges"] == ["none", "170.5–189.5 deg, 350.0–359.5 deg"]
+    assert table["kinematic estimate"] == ["112.750 mm", "-2.000 mm"]
+    assert table["evaluations"] == ["977", "977"]
+    checks = {name: ok for name, ok, _ in overall_checks(report)}
+    assert checks["sweep: arm distance"] and not checks["sweep: ground clearance (solids)"]
+    assert 'verdict fail">FAIL<' in page
+
+
+def test_output_is_deterministic(planting, figures):
+    first = render_html(planting, figures)
+    reordered = dict(reversed(list(figures.items())))
+    assert render_html(copy.deepcopy(planting), reordered) == first
+    assert render_html(planting, figures) == first
+
+
+def test_text_is_escaped(planting):
+    report = copy.deepcopy(planting)
+    report["design"] = "a<b & c"
+    report["metrics"][0]["label"] = '<script>alert("x")</script> & <em>'
+    report["scene"] = {"case": "<case>", "effects": ["soil & stones"]}
+    report["preset"] = "<fast>"
+    page = render_html(report, {"x<y>&z.png": tiny_png(1)})
+    parse(page)
+    assert "<script" not in page and "<em>" not in page and "<case>" not in page
+    assert "a&lt;b &amp; c" in page
+    assert "&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt; &amp; &lt;em&gt;" in page
+    assert "&lt;case&gt; (effects: soil &amp; stones)" in page and "&lt;fast&gt;" in page
+    assert 'alt="X&lt;y&gt;&amp;z"' in page
+
+
+def test_pricking_field_table_and_findings():
+    page = render_html(PRICKING, {})
+    table = rows(section(page, "field"))
+    header = table[0]
+    assert header[:4] == ["inclination", "needle entry", "needle exit", "hole mouth"]
+    assert table[1][:4] == ["6.5 deg", "81.85 deg", "72.25 deg", "30.00 mm"]
+    assert table[2][0] == "33.5 deg" and table[2][-1] == "FAIL yes"   # needle root in soil
+    assert html.escape(PRICKING["findings"][0]["message"]) in page
+    assert [name for name, _, _ in overall_checks(PRICKING)] == ["forward kinematic check"]
+    assert 'verdict pass">PASS<' in page
+    assert 'verdict fail">FAIL<' in render_html(dict(PRICKING, verified=False), {})
+
+
+def test_gears_solids_and_stages_sections():
+    report = dict(PRICKING, gear_train=GEAR_TRAIN, solids=SOLIDS,
+                  stages=[{"stage": "gears", "seconds": 1.5, "status": "ok", "message": ""},
+                          {"stage": "sweep", "seconds": 0.25, "status": "failed",
+                           "message": "fcl <missing>"}])
+    page = render_html(report, {})
+    gears = rows(section(page, "gears"))
+    assert gears[1][:4] == ["sun", "stage 1", "26", "2.0000"] and gears[1][-1] == "WARN undercut"
+    assert "the planet gear cannot be cut" in section(page, "gears")
+    solids = rows(section(page, "solids"))
+    assert solids[1] == ["gear-case", "housing", "1", "191773", "1.505", "(-1.84, 0.00, 15.00)",
+                         "776", "PASS"]
+    assert solids[-1] == ["gear-case", "FAIL", "-0.750 mm", "sun", "PASS"]
+    stages = rows(section(page, "stages"))
+    assert stages[1:] == [["gears", "1.500", "ok", ""],
+                          ["sweep", "0.250", "failed", "fcl <missing>"],
+                          ["total", "1.750", "", ""]]
+    failed = [name for name, ok, _ in overall_checks(report) if not ok]
+    assert failed == ["gears cut", "housings enclose their gears", "stages ran"]
+    # Timings only (today's reports): a two-column table.
+    assert rows(section(render_html(PRICKING, {}), "stages"))[1:] == [
+        ["inverse_design", "0.500"], ["field", "0.250"], ["total", "0.750"]]
+
+
+def test_cam_section_and_its_problems(planting):
+    report = dict(planting, cam=CAM)
+    body = section(render_html(report, {}), "cam")
+    table = {row[0]: row[1] for row in rows(body) if len(row) == 2}
+    assert table["opening angle"] == "13.75 deg" and table["roller radius"] == "6 mm"
+    assert "<td>opening</td><td>(183.25, 213.25) deg</td>" in body     # nested: carrier angle
+    assert "<td>opening</td><td>cycloidal</td>" in body                  # nested: laws
+    assert ">FAIL<" in body and html.escape(CAM["problems"][0]["message"]) in body
+    assert ("cam", False, "1 problem") in overall_checks(report)
+
+
+def test_report_failures_decide_the_verdict(planting):
+    report = copy.deepcopy(planting)
+    report["failures"] = ["gearbox1 does not enclose its gears (margin -1.00 mm at <sun>)"]
+    report["passed"] = False
+    report["metrics"][0]["kinematic_estimate"] = 99.5
+    page = render_html(report, {})
+    header = page[page.index("<header>"): page.index("</header>")]
+    assert 'verdict fail">FAIL<' in header and html.escape(report["failures"][0]) in header
+    assert dict((name, ok) for name, ok, _ in overall_checks(report))["report verdict"] is False
+    table = rows(section(page, "metrics"))
+    assert table[0][-1] == "kinematic estimate"
+    assert table[1][-1] == "99.500 mm" and table[2][-1] == ""
+    # Reports that list failures count pricking findings among them.
+    pricking = render_html(dict(PRICKING, failures=["[undercut] ..."], passed=False), {})
+    assert "FAIL</span> <code>[undercut]</code>" in section(pricking, "field")
+    assert "WARN</span> <code>[undercut]</code>" in section(render_html(PRICKING, {}), "field")
+
+
+def test_accuracy_is_listed(planting):
+    body = section(render_html(planting, {}), "accuracy")
+    for key in planting["accuracy"]:
+        assert html.escape(key.replace("_", " ").removesuffix(" mm").removesuffix(" rad")) in body
+
+
+def test_write_html_writes_the_page_atomically(planting, figures, tmp_path):
+    path = write_html(planting, figures, tmp_path / "report.html")
+    assert path == tmp_path / "report.html"
+    assert path.read_text(encoding="utf-8") == render_html(planting, figures)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.html"]
+
+
+def test_rejects_figures_that_are_not_png(planting):
+    with pytest.raises(ValueError, match="'plot.png' is not PNG data"):
+        render_html(planting, {"plot.png": b"GIF89a..."})
+
+
+@pytest.mark.parametrize("name, caption", [
+    ("tip_velocity.png", "Tip velocity"),
+    ("gears-3-train-1-sun-to-idler-1.png", "Gear pair 3: train 1 sun to idler 1"),
+    ("cam-contour.png", "Cam contour"),
+    ("clearance.png", "Clearance"),
+], ids=["underscores", "gear-pair", "dashes", "sweep"])
+def test_figure_caption(name, caption):
+    assert figure_caption(name) == caption
+
+
+def _render_script():
+    path = Path(__file__).resolve().parents[1] / "scripts" / "render_report.py"
+    spec = importlib.util.spec_from_file_location("render_report", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_render_script_says_when_chromium_is_missing(tmp_path, capsys):
+    page = tmp_path / "report.html"
+    page.write_text("<!DOCTYPE html><title>x</title>", encoding="utf-8")
+    code = _render_script().main([str(page), "--png", str(tmp_path / "shot.png"),
+                                  "--chromium", str(tmp_path / "no-such-chromium")])
+    assert code == 2
+    error = capsys.readouterr().err
+    assert "Chromium was not found" in error and "apt-get install -y chromium" in error
+    assert not (tmp_path / "shot.png").exists()
