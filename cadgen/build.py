@@ -54,7 +54,7 @@ EFFECT_STAGES = {
     "solids": ("cam", "parts"),       # gears among the solids when "teeth" runs too
     "arm_interference": ("cam", "parts", "arm_interference"),
     "ground_clearance": ("metrics", "parts", "ground_clearance"),
-    "dxf": ("teeth", "cam"),
+    "dxf": (),                 # the cutting files of the teeth and cam that run (both if alone)
     "stl": ("cam", "parts"),
     "plots": ("plots",),
     "report": (),
@@ -90,6 +90,8 @@ def plan(effects, mechanism: str = "planting", case: str = "field"):
             set_aside[effect] = reason
             continue
         wanted.update(EFFECT_STAGES[effect])
+    if "dxf" in effects and not {"teeth", "meshing", "cam", "solids", "stl"} & set(effects):
+        wanted.update(("teeth", "cam"))   # asked alone, DXF means every cutting file
     if mechanism == "pricking":
         wanted.discard("cam")
         wanted.discard("arm_interference")

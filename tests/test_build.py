@@ -75,7 +75,7 @@ def test_a_failed_stage_is_reported_its_dependents_skipped_the_rest_written(
         raise DesignError([Problem("cam.roller_radius", "synthetic", "the cam stage broke")])
 
     monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, "cam", broken)
-    result = build(params, tmp_path, effects=["metrics", "cam", "curves", "dxf"])
+    result = build(params, tmp_path, effects=["metrics", "teeth", "cam", "curves", "dxf"])
     stages = {s["stage"]: s for s in result.report["stages"]}
     assert stages["cam"]["status"] == "failed" and "the cam stage broke" in stages["cam"]["message"]
     assert stages["cam"]["problems"][0]["path"] == "cam.roller_radius"
