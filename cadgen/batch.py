@@ -26,14 +26,13 @@ least three digits (``r-sweep-003``). Keys may also be written as TOML dotted ke
 
 The command line (``cadgen batch``) is :func:`add_batch_arguments` plus :func:`main_batch`.
 
-TODO(timeouts, worker deaths): there is no per-design ``--timeout`` yet. A clean one
-is possible for local processes only (``signal.alarm`` in the worker, whose main
-thread runs the task, so the staged output directory is removed on the way out); Dask
-runs tasks in worker threads, which cannot be interrupted, so a timed-out design
-could still write its folder after being reported failed. The fix is to run each
-design in a child process that the job can kill, for both executors. A worker that
-dies (segfault, out of memory) is reported per design as ``worker_error``; with local
-processes it breaks the pool, so every design not finished by then is reported so too.
+TODO(timeouts, worker deaths): no per-design ``--timeout`` yet. ``signal.alarm`` in
+the worker would do for local processes (the task runs in its main thread, and the
+staged output folder is removed on the way out), but Dask runs tasks in threads that
+cannot be interrupted: a timed-out design could still write its folder after being
+reported failed. The fix for both: each design in a child process the job can kill.
+A worker that dies (segfault, out of memory) is reported as ``worker_error``; with
+local processes it breaks the pool, so every unfinished design is reported so too.
 """
 
 from __future__ import annotations
@@ -123,7 +122,8 @@ class DesignJob:
 
 class GridError(DesignError):
     """A grid file with problems; ``problems`` lists all of them (paths ``grid.<key>``,
-    ``base``, ``name``). Also a :class:`ValueError`."""
+    ``base``, ``name``). A DesignError and a ValueError (not a ParameterError, whose
+    module pulls in pydantic when imported)."""
 
 
 def _peek_name(path: Path) -> str:
@@ -173,6 +173,8 @@ def guard_names(jobs: Sequence[DesignJob]) -> list[DesignJob]:
         if job.name in (SUMMARY_CSV, SUMMARY_HTML):
             job = replace(job, blocked_by=f"design name {job.name!r} is the batch summary's "
                                           "file name; rename the design")
+        elif job.name in first and first[job.name].source == job.source:
+            job = replace(job, blocked_by=f"{job.source} is given twice; it is built once")
         elif job.name in first:
             job = replace(job, blocked_by=f"design name {job.name!r} is also the name of "
                                           f"{first[job.name].source}, built instead; its outputs "
@@ -308,9 +310,8 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
         that only a combination of values shows (and the kinematic feasibility
         checks) are each design's own, reported when it is built.
     """
-    from cadgen.params import validate_data
-    from cadgen.params._tables import NAME_MAX_LENGTH, NAME_PATTERN
-    from cadgen.params.loading import ParameterError
+    from cadgen.params import NAME_PATTERN, ParameterError, validate_data
+    from cadgen.params._tables import NAME_MAX_LENGTH
 
     grid_path = Path(grid_file)
     source = str(grid_file)
@@ -567,8 +568,10 @@ def run_design(job: DesignJob, output_root: str | os.PathLike, build: Build | No
 # --------------------------------------------------------------------------- executors
 
 
-def _order(summary: Mapping) -> tuple[str, str]:
-    return summary["name"], summary["source"]
+def _order(summary: Mapping) -> tuple:
+    """Summary order: by name, then source; a file given twice: the built one first."""
+    failure = summary["failure"] or {}
+    return summary["name"], summary["source"], not summary["ok"], failure.get("code", "")
 
 
 def _collect(futures: Mapping, finished: Iterable, on_result) -> list[dict]:
@@ -722,6 +725,14 @@ def _missed(summary: Mapping) -> str:
     return ";".join(k for k, m in summary["metrics"].items() if m["passed"] is False)
 
 
+def _why_not(summary: Mapping) -> str:
+    """Why a built design did not pass: its missed targets, else its report's first note."""
+    missed, notes = _missed(summary), summary.get("notes") or ()
+    if missed or not notes:
+        return "missed " + (missed.replace(";", ", ") or "its targets")
+    return notes[0] + (f" (+{len(notes) - 1} more)" if len(notes) > 1 else "")
+
+
 def summary_csv(summaries: Sequence[Mapping]) -> str:
     """The batch summary as CSV text: one row per design, ordered by name.
 
@@ -757,8 +768,7 @@ body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; }
 table { border-collapse: collapse; font-size: 0.9em; } th { background: #f3f3f3; }
 th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; vertical-align: top; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; } .ok { color: #176117; }
-.failed, .miss { color: #a40000; font-weight: bold; }
-td.reason { max-width: 40em; white-space: pre-wrap; }
+.failed, .miss { color: #a40000; font-weight: bold; } td.reason { white-space: pre-wrap; }
 """
 
 
@@ -773,7 +783,7 @@ def summary_html(summaries: Sequence[Mapping], title: str = "Batch summary") -> 
     grid_keys, metric_ids = _columns(ordered)
     units = {k: m.get("unit") or "" for s in reversed(ordered) for k, m in s["metrics"].items()}
     built = sum(s["ok"] for s in ordered)
-    missed = sum(s["ok"] and s["passed"] is False for s in ordered)
+    not_passed = sum(s["ok"] and s["passed"] is False for s in ordered)
     head = ["design", "status", "passed", *grid_keys,
             *(f"{k} ({units[k]})" if units[k] else k for k in metric_ids), "failure or notes",
             "source"]
@@ -801,7 +811,7 @@ def summary_html(summaries: Sequence[Mapping], title: str = "Batch summary") -> 
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
         f"<title>{esc(title)}</title>\n<style>{_HTML_STYLE}</style>\n</head>\n<body>\n"
         f"<h1>{esc(title)}</h1>\n<p>{len(ordered)} designs: {built} built, "
-        f"{len(ordered) - built} failed, {missed} missed targets.</p>\n"
+        f"{len(ordered) - built} failed, {not_passed} built but did not pass.</p>\n"
         "<table>\n<thead><tr>" + "".join(f"<th>{esc(h)}</th>" for h in head) + "</tr></thead>\n"
         "<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>\n</body>\n</html>\n"
     )
@@ -848,8 +858,8 @@ def _reason(summary: Mapping) -> str:
 class Progress:
     """A one-line progress bar: ``[12/40] 30% ok 11, failed 1, eta 00:42``.
 
-    On a terminal the line is redrawn in place (failures are printed above it); on
-    anything else (a log file, CI) it prints one line per finished design instead.
+    On a terminal the line is redrawn in place (failures printed above it); elsewhere (a
+    log, CI) it prints one line per finished design.
 
     Parameters
     ----------
@@ -866,6 +876,9 @@ class Progress:
         self.tty = bool(tty if tty is not None else getattr(self.stream, "isatty", bool)())
         self.done = self.ok = self.failed = 0
         self.start = time.perf_counter()
+        if self.tty:  # show the bar at once: the first design may take a while
+            self.stream.write(self.line())
+            self.stream.flush()
 
     def line(self) -> str:
         """The current progress line (no line break)."""
@@ -912,17 +925,10 @@ def _positive_int(text: str) -> int:
 
 
 def add_batch_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """Add the ``cadgen batch`` arguments to ``parser`` (a subcommand's parser).
+    """Add the ``cadgen batch`` arguments to ``parser`` (a subcommand's parser) and return it.
 
-    ``FILE ...`` parameter files, ``--grid GRID`` (repeatable), ``--output-dir DIR``
-    (default ``outputs``), ``--workers N`` (default: the number of CPUs),
-    ``--scheduler ADDRESS`` (a Dask scheduler), ``--strict``. Also sets
-    ``handler=main_batch`` as the parser's default.
-
-    Returns
-    -------
-    argparse.ArgumentParser
-        ``parser``.
+    ``FILE ...``, ``--grid GRID`` (repeatable), ``--output-dir DIR``, ``--workers N``,
+    ``--scheduler ADDRESS``, ``--strict``; also sets the default ``handler=main_batch``.
     """
     parser.add_argument("files", nargs="*", metavar="FILE", help="TOML parameter file")
     parser.add_argument("--grid", action="append", default=[], metavar="GRID",
@@ -944,12 +950,8 @@ def add_batch_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
 
 
 def main_batch(args: argparse.Namespace) -> int:
-    """Run ``cadgen batch``: build every design, write the summary, print where it is.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        As parsed with :func:`add_batch_arguments`.
+    """Run ``cadgen batch`` (``args`` from :func:`add_batch_arguments`): build every design,
+    write the summary, print where it is.
 
     Returns
     -------
@@ -985,13 +987,13 @@ def main_batch(args: argparse.Namespace) -> int:
     csv_path, html_path = write_summary(summaries, args.output_dir)
 
     built = sum(s["ok"] for s in summaries)
-    missed = [s for s in summaries if s["ok"] and s["passed"] is False]
+    not_passed = sum(s["ok"] and s["passed"] is False for s in summaries)
     print(f"{len(summaries)} designs in {_clock(time.perf_counter() - start)}: {built} built, "
-          f"{len(summaries) - built} failed, {len(missed)} missed targets")
+          f"{len(summaries) - built} failed, {not_passed} built but did not pass")
     for s in summaries:
         if not s["ok"]:
             print(f"  failed {s['name']} ({s['source']}): {_reason(s)}")
         elif s["passed"] is False:
-            print(f"  missed targets {s['name']}: {_missed(s).replace(';', ', ')}")
+            print(f"  did not pass {s['name']}: {_why_not(s)}")
     print(f"summary: {csv_path}\n         {html_path}")
     return batch_exit_code(summaries, args.strict)

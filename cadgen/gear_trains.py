@@ -242,7 +242,7 @@ def train_report(train: GearTrain) -> dict:
 
 def pair_figures(train: GearTrain) -> dict:
     """A picture of each pair at the start position, problem teeth marked (PNG bytes)."""
-    from .plots import _figure, _png
+    from .plots import _figure, _fill, _png
 
     figures = {}
     for index, stage in enumerate(train.stages):
@@ -252,7 +252,7 @@ def pair_figures(train: GearTrain) -> dict:
         for k, (profile, check) in enumerate(zip(stage.generated.profiles,
                                                  stage.generated.checks)):
             outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
-            ax.fill(outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
+            _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
                     f"({profile.teeth} teeth, {check.cutter})")
             ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
         m = stage.meshing

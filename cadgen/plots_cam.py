@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plots import _figure, _png
+from .plots import _figure, _fill, _png
 
 __all__ = ["cam_figures"]
 
@@ -55,7 +55,7 @@ def contour(design, points: int) -> bytes:
     figure, ax = _figure(6.5, 6.5)
     working = profile.working_profile(points)
     pitch = profile.pitch_curve(points)
-    ax.fill(working[:, 0], working[:, 1], color="0.8", label="cam (working profile)")
+    _fill(ax, working[:, 0], working[:, 1], color="0.8", label="cam (working profile)")
     ax.plot(*np.vstack([working, working[:1]]).T, color="k", lw=0.8)
     ax.plot(*np.vstack([pitch, pitch[:1]]).T, color="tab:blue", ls="--", lw=0.8,
             label="pitch curve (roller centre)")

@@ -6,7 +6,7 @@ import numpy as np
 
 from kinematics.planar import cross
 
-from .plots import _figure, _png
+from .plots import _figure, _fill, _png
 
 __all__ = ["assembly_view"]
 
@@ -45,9 +45,9 @@ def assembly_view(assembly, angle: float, *, title: str, paths=(), soil_level=No
             if polygon.is_empty or not isinstance(polygon, shapely.Polygon):
                 continue
             x, y = polygon.exterior.xy
-            ax.fill(x, y, color=_COLOURS.get(part.kind, "0.6"), ec="k", lw=0.3, alpha=0.95)
+            _fill(ax, x, y, color=_COLOURS.get(part.kind, "0.6"), ec="k", lw=0.3, alpha=0.95)
             for ring in polygon.interiors:
-                ax.fill(*ring.xy, color="white", ec="k", lw=0.3)
+                _fill(ax, *ring.xy, color="white", ec="k", lw=0.3)
     for xy, label in paths:
         ax.plot(xy[:, 0], xy[:, 1], "k--", lw=0.8, label=label)
     if soil_level is not None:

@@ -234,8 +234,11 @@ def test_a_build_given_as_a_path(tmp_path):
 
 
 def test_a_repeated_name_is_not_built(tmp_path):
-    first, second = guard_names(file_jobs([REFERENCE, REFERENCE]))
+    copy = tmp_path / "copy.toml"
+    copy.write_text(REFERENCE.read_text())
+    first, second, third = guard_names(file_jobs([REFERENCE, copy, REFERENCE]))
     assert first.blocked_by is None and "rename one" in second.blocked_by
+    assert "given twice" in third.blocked_by
     summary = run_design(second, tmp_path, build_kwargs=FAST)
     assert not summary["ok"] and summary["failure"]["code"] == "duplicate_name"
     assert not (tmp_path / "xin2024-planter").exists()
@@ -297,8 +300,10 @@ def test_progress_without_a_terminal_prints_one_line_per_design():
 def test_progress_on_a_terminal_redraws_one_line():
     stream = io.StringIO()
     progress = Progress(4, stream, tty=True)
+    assert stream.getvalue() == "[0/4] 0% ok 0, failed 0"
     progress.update(summary_of("a", True))
-    assert stream.getvalue().startswith("\r\x1b[K[1/4] 25% ok 1, failed 0, eta ")
+    assert stream.getvalue().startswith("[0/4] 0% ok 0, failed 0\r\x1b[K[1/4] 25% ok 1, "
+                                        "failed 0, eta ")
     progress.update(summary_of("b", False))
     progress.close()
     text = stream.getvalue()

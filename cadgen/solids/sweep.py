@@ -24,7 +24,11 @@ most ``u`` mm/rad, every point of the part moves at most::
 
 A group's bound is the largest over its instances, and the pair's is the sum
 of the two groups' bounds (a fixed group contributes 0). :func:`part_reach`
-gives the geometric factor; the speeds belong to the mechanism.
+gives the geometric factor; the speeds belong to the mechanism. The optional
+acceleration bound is formed the same way from the origin's acceleration
+``a``, the angular acceleration ``alpha`` and rate ``w``: ``a + (alpha + w**2)
+* reach (+ the local motion's)``; with it the search is second order (see
+:func:`certified_distance`).
 
 python-fcl 0.7.0.11, measured (see ``tests/test_sweep_fcl.py``):
 
@@ -52,6 +56,7 @@ from cadgen.solids.errors import SolidInputError
 __all__ = [
     "INTERFERENCE_XTOL",
     "INTERFERENCE_RESOLUTION",
+    "MAX_EVALUATIONS",
     "Proximity",
     "FclScene",
     "SweepResult",
@@ -66,6 +71,8 @@ INTERFERENCE_XTOL = 1e-9
 #: Narrowest interval (rad) the interference scan splits where the Lipschitz bound
 #: cannot rule out an overlap; an overlap shorter than this can hide in one.
 INTERFERENCE_RESOLUTION = 1e-6
+#: Default budget of poses of :func:`certified_distance` (each pass).
+MAX_EVALUATIONS = 20_000
 #: Covering spheres of a part: 2**depth leaves, on triangles no longer than this
 #: fraction of the part's bounding radius (they only prune pairs: speed, not accuracy).
 _LEAF_DEPTH = 4
@@ -407,8 +414,8 @@ class SweepResult:
         :func:`certified_distance`).
     samples_phi, samples_distance : (steps + 1,) float
         The screening grid and its distances, to plot distance against carrier angle.
-    lipschitz, atol : float
-        As given.
+    lipschitz, acceleration, atol : float
+        As given (``acceleration`` None when not given).
     seconds : float
         Wall time of the sweep.
     """
@@ -426,6 +433,7 @@ class SweepResult:
     samples_phi: np.ndarray = field(repr=False)
     samples_distance: np.ndarray = field(repr=False)
     lipschitz: float = 0.0
+    acceleration: float | None = None
     atol: float = 0.0
     seconds: float = 0.0
 
@@ -456,18 +464,20 @@ class _Memo:
         return self.values[float(phi)]
 
 
-def _interference(distance, grid, values, lipschitz, xtol, resolution):
+def _interference(distance, grid, values, lipschitz, xtol, resolution, budget):
     """Overlap ranges from the screening samples, refined where the bound allows an overlap.
 
     Level by level, as :func:`certified_minimum` does: an interval with both ends
     overlapping counts as overlapping; both ends clear and
     ``(d_left + d_right - L h) / 2 > 0``: clear, certified; one end of each:
     split until narrower than ``xtol`` (bisection of the boundary); otherwise
-    split until narrower than ``resolution``.
+    split until narrower than ``resolution``. Returns ``(ranges, unresolved,
+    evaluations)``; intervals left when ``budget`` evaluations are spent count
+    as unresolved.
     """
     left, right = grid[:-1], grid[1:]
     f_left, f_right = values[:-1], values[1:]
-    ranges, unresolved = [], 0
+    ranges, unresolved, evaluations = [], 0, 0
     while left.size:
         o_left, o_right = f_left <= 0.0, f_right <= 0.0
         width = right - left
@@ -483,11 +493,15 @@ def _interference(distance, grid, values, lipschitz, xtol, resolution):
         small = possible & (width <= resolution)
         unresolved += int(small.sum())
         split = (mixed & ~settled) | (possible & ~small)
+        if evaluations + int(split.sum()) > budget:
+            unresolved += int(split.sum())
+            break
         left, right, middle = left[split], right[split], middle[split]
         f_left, f_right = f_left[split], f_right[split]
         if not left.size:
             break
         f_middle = distance(middle)
+        evaluations += middle.size
         left, right = np.concatenate([left, middle]), np.concatenate([middle, right])
         f_left, f_right = np.concatenate([f_left, f_middle]), np.concatenate([f_middle, f_right])
     merged = []
@@ -496,24 +510,32 @@ def _interference(distance, grid, values, lipschitz, xtol, resolution):
             merged[-1] = (merged[-1][0], max(merged[-1][1], end))
         else:
             merged.append((start, end))
-    return merged, unresolved
+    return merged, unresolved, evaluations
 
 
-def certified_distance(scene: FclScene, *, lipschitz: float, steps: int = 360, atol: float = 1e-6,
+def certified_distance(scene: FclScene, *, lipschitz: float, acceleration: float | None = None,
+                       steps: int = 360, atol: float = 1e-6,
                        lower: float = 0.0, upper: float = 2.0 * math.pi,
                        xtol: float = INTERFERENCE_XTOL,
                        resolution: float = INTERFERENCE_RESOLUTION,
-                       max_evaluations: int = 200_000) -> SweepResult:
+                       max_evaluations: int = MAX_EVALUATIONS) -> SweepResult:
     """Certified least distance between the scene's groups over ``[lower, upper]``, and interference.
 
     Parameters
     ----------
     scene : FclScene
     lipschitz : float
-        Upper bound (mm/rad) on ``|d distance / d phi|``: the largest relative
-        speed of any point of group A against any point of group B (see the
-        module notes). The caller's responsibility: too small a bound voids the
-        certificate.
+        Upper bound ``L`` (mm/rad) on ``|d distance / d phi|``: the largest
+        relative speed of any point of group A against any point of group B (see
+        the module notes). The caller's responsibility: too small a bound voids
+        the certificate.
+    acceleration : float, optional
+        Upper bound ``A`` (mm/rad^2) on the relative acceleration of any point of
+        A against any point of B. The distance is then screened to second order,
+        ``d'' <= A + L^2 / d`` (it is the least of point-to-point distances, each
+        obeying that), which a smooth minimum needs: with ``L`` alone the search
+        splits down to intervals of ``2 atol / L`` round it, thousands of poses.
+        A kink (the nearest features switching) needs only ``L``.
     steps : int
         Intervals of the screening grid.
     atol : float
@@ -527,7 +549,9 @@ def certified_distance(scene: FclScene, *, lipschitz: float, steps: int = 360, a
     resolution : float
         Narrowest interval (rad) split in search of an overlap.
     max_evaluations : int
-        Budget of the minimum search (as :func:`certified_minimum`).
+        Budget of poses, for the minimum search and again for the interference
+        scan; when spent, ``certified`` is False (or ``unresolved`` counts the
+        intervals left).
 
     Notes
     -----
@@ -547,6 +571,8 @@ def certified_distance(scene: FclScene, *, lipschitz: float, steps: int = 360, a
 
     if not (math.isfinite(lipschitz) and lipschitz >= 0.0):
         raise SolidInputError("lipschitz", f"must be a finite bound >= 0, not {lipschitz!r}")
+    if acceleration is not None and not (math.isfinite(acceleration) and acceleration >= 0.0):
+        raise SolidInputError("acceleration", f"must be a finite bound >= 0, not {acceleration!r}")
     if not (isinstance(steps, (int, np.integer)) and steps >= 2):
         raise SolidInputError("steps", f"must be an integer >= 2, not {steps!r}")
     if not (math.isfinite(lower) and math.isfinite(upper) and upper > lower):
@@ -554,27 +580,34 @@ def certified_distance(scene: FclScene, *, lipschitz: float, steps: int = 360, a
     if not (xtol > 0.0 and resolution >= xtol):
         raise SolidInputError("xtol", f"need 0 < xtol <= resolution, got {xtol!r} and {resolution!r}")
     start = time.perf_counter()
+    lipschitz = float(lipschitz)
+    curvature = None
+    if acceleration is not None:
+        def curvature(first_order_bounds):
+            with np.errstate(divide="ignore"):
+                return np.where(first_order_bounds > 0.0,
+                                acceleration + lipschitz**2 / first_order_bounds, np.inf)
     memo = _Memo(scene)
-    found = certified_minimum(memo, lower, upper, steps=int(steps), lipschitz=float(lipschitz),
-                              atol=atol, max_evaluations=max_evaluations)
+    found = certified_minimum(memo, lower, upper, steps=int(steps), lipschitz=lipschitz,
+                              curvature=curvature, atol=atol, max_evaluations=max_evaluations)
     # certified_minimum's screening grid, posed once and cached
     grid = np.linspace(lower, upper, int(steps) + 1)
     values = memo(grid)
-    ranges, unresolved = _interference(memo, grid, values, float(lipschitz), xtol, resolution)
+    ranges, unresolved, _ = _interference(memo, grid, values, lipschitz, xtol, resolution,
+                                          max_evaluations)
     minimum, argument, bound = found.value, found.argument, found.bound
-    if ranges and minimum > 0.0:   # an overlap found between samples by the scan
-        argument, minimum, bound = 0.5 * (ranges[0][0] + ranges[0][1]), 0.0, min(bound, 0.0)
+    if ranges and minimum > 0.0:   # an overlap the minimum search did not land in
+        argument, minimum = 0.5 * (ranges[0][0] + ranges[0][1]), 0.0
     if minimum <= 0.0:
         bound = min(bound, 0.0)
     near = memo.proximity(argument)
-    if near.distance < minimum:   # the scan's pose may have been slightly off the minimum
-        minimum = near.distance
+    minimum = min(minimum, near.distance)
     return SweepResult(
         minimum=float(minimum), argument=float(argument), bound=float(bound),
         certified=bool(minimum - bound <= atol * (1.0 + 1e-9)), evaluations=len(memo.values),
         point_a=near.point_a, point_b=near.point_b, pair=near.pair,
         interference_ranges=ranges, unresolved=unresolved, samples_phi=grid,
-        samples_distance=values, lipschitz=float(lipschitz), atol=float(atol),
+        samples_distance=values, lipschitz=lipschitz, acceleration=acceleration, atol=float(atol),
         seconds=time.perf_counter() - start)
 
 
