@@ -66,7 +66,7 @@ __all__ = [
     "add_batch_arguments", "main_batch",
 ]
 
-DEFAULT_BUILD = "cadgen.analyze:run_analysis"
+DEFAULT_BUILD = "cadgen.build:build"
 """The build each design runs unless told otherwise: ``"module:function"``, called as
 ``build(params, output_root=Path, **build_kwargs)``; it returns an object with
 ``report`` (dict) and ``output_dir`` (and optionally ``files``), or the report dict."""
@@ -83,7 +83,6 @@ _GRID_KEYS = ("base", "name", "grid")
 _RANGE_KEYS = ("start", "stop", "num")
 _NOT_SWEPT = ("name", "mechanism")
 _MIN_INDEX_DIGITS = 3
-_CHECK_NAME = "grid-check"
 _TRACEBACK_LINES = 30
 
 Build = Callable[..., Any] | str
@@ -104,8 +103,7 @@ class DesignJob:
     source : str
         The parameter file or grid file, as the user gave it.
     path, data : str or None, dict or None
-        The absolute path of the parameter file to load, or the parsed parameters of a
-        grid design.
+        The parameter file's absolute path, or the parsed parameters of a grid design.
     values : dict
         The grid values set in this design (dotted key -> value); empty for a file.
     blocked_by : str or None
@@ -260,7 +258,7 @@ def _axis_values(key: str, spec: Any) -> tuple[list | None, list[Problem]]:
     num = spec.get("num")
     if "num" in spec and not (_is_number(num) and isinstance(num, int) and num >= 1):
         problems.append(Problem(f"{where}.num", "out_of_range" if _is_number(num) else "wrong_type",
-                                f"{key} num must be a whole number of at least 1, not {_show(num)}"))
+                                f"{key} num must be a whole number, at least 1, not {_show(num)}"))
     if problems:
         return None, problems
     return _linspace(spec["start"], spec["stop"], num), []
@@ -388,7 +386,7 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
     for key, values in axes:
         for index, value in enumerate(values):
             data = copy.deepcopy(base_data)
-            data["name"] = _CHECK_NAME  # the real names are checked above
+            data["name"] = "grid-check"  # the real names are checked above
             reasons = [_assign(data, k, value if k == key else firsts[k]) for k in firsts]
             reason = next((r for r in reasons if r), None)
             if reason:
@@ -601,8 +599,8 @@ def _run_local(jobs, output_root, build, build_kwargs, workers, on_result):
     except Exception as exc:
         raise TypeError(f"the build {build!r} cannot be sent to worker processes ({exc}); "
                         "give a module-level function or 'module:function'") from None
-    # spawn: the same start method on every platform, and safe when the parent holds
-    # threads (a Dask client, a BLAS pool); each worker pays its imports once.
+    # spawn: one start method on every platform, safe when the parent holds threads (a
+    # Dask client); each worker pays its imports once (fork saves ~0.2 s per worker).
     context = multiprocessing.get_context("spawn")
     pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))), mp_context=context)
     try:
@@ -670,7 +668,8 @@ def run_batch(jobs: Sequence[DesignJob], output_root: str | os.PathLike = "outpu
 
     Notes
     -----
-    No per-design timeout yet (see the module docstring's TODO).
+    Local workers are spawned, not forked (safe beside a Dask client's threads), so a
+    script calling this needs ``if __name__ == "__main__":``. No timeout yet (TODO above).
     """
     if not jobs:
         return []
@@ -817,7 +816,7 @@ def summary_html(summaries: Sequence[Mapping], title: str = "Batch summary") -> 
     )
 
 
-def write_summary(summaries: Sequence[Mapping], output_root: str | os.PathLike) -> tuple[Path, Path]:
+def write_summary(summaries: Sequence[dict], output_root: str | os.PathLike) -> tuple[Path, Path]:
     """Write ``batch-summary.csv`` and ``.html`` atomically under ``output_root``; their paths."""
     from .atomic import write_text_atomic
 
@@ -988,7 +987,8 @@ def main_batch(args: argparse.Namespace) -> int:
 
     built = sum(s["ok"] for s in summaries)
     not_passed = sum(s["ok"] and s["passed"] is False for s in summaries)
-    print(f"{len(summaries)} designs in {_clock(time.perf_counter() - start)}: {built} built, "
+    took, plural = _clock(time.perf_counter() - start), "s" * (len(summaries) != 1)
+    print(f"{len(summaries)} design{plural} in {took}: {built} built, "
           f"{len(summaries) - built} failed, {not_passed} built but did not pass")
     for s in summaries:
         if not s["ok"]:

@@ -137,3 +137,28 @@ def test_pricking_build_runs_its_own_stages(tmp_path):
     # kernel-a's gears are concave: the design does not pass, and says why
     assert not result.report["passed"]
     assert any("concave" in f for f in result.report["failures"])
+
+
+def test_sweeps_replace_the_kinematic_estimates_and_keep_them_beside(params):
+    result = build(params, None, effects=["metrics", "arm_interference", "ground_clearance"])
+    report = result.report
+    metrics = {m["key"]: m for m in report["metrics"]}
+    for key, sweep_key in (("arm_distance", "arm_interference"),
+                           ("ground_clearance", "ground_clearance")):
+        sweep = report["sweep"][sweep_key]
+        assert metrics[key]["value"] == sweep["minimum_mm"]
+        assert metrics[key]["kinematic_estimate"] == sweep["kinematic_estimate_mm"]
+        assert sweep["certified"] and sweep["certified_bound_mm"] <= sweep["minimum_mm"]
+        assert sweep["minimum_mm"] - sweep["certified_bound_mm"] <= sweep["atol_mm"] * (1 + 1e-9)
+        assert sweep["interference_ranges_deg"] == [] and sweep["passed"]
+        gap = [b - a for a, b in zip(*sweep["nearest_points_mm"])]
+        assert sum(g * g for g in gap) ** 0.5 == pytest.approx(sweep["minimum_mm"], abs=1e-9)
+    # the solids' arms come closer than their centre lines: the cam of one passes the other's shell
+    arms = report["sweep"]["arm_interference"]
+    assert arms["minimum_mm"] < arms["kinematic_estimate_mm"]
+    # the housings are the hull of the envelope circles: the same clearance, to the polygon sag
+    ground = report["sweep"]["ground_clearance"]
+    assert ground["kinematic_estimate_mm"] - 0.03 < ground["minimum_mm"] <= \
+        ground["kinematic_estimate_mm"] + 1e-6
+    assert [s["stage"] for s in report["stages"]] == [
+        "kinematics", "metrics", "cam", "parts", "arm_interference", "ground_clearance"]

@@ -105,7 +105,7 @@ def instance_pose(assembly, name: str, phi: float) -> np.ndarray:
 
 
 def part_reach(part, body_origin_local=(0.0, 0.0, 0.0), *, phi: float = 0.0, axis=None) -> float:
-    """Largest distance (mm) of a part's vertices from a point of its body, after its local placement.
+    """Largest distance (mm) of a part's vertices from a point of its body, placed in the body.
 
     Parameters
     ----------
@@ -126,7 +126,8 @@ def part_reach(part, body_origin_local=(0.0, 0.0, 0.0), *, phi: float = 0.0, axi
     """
     origin = np.asarray(body_origin_local, dtype=float)
     if origin.shape != (3,) or not np.all(np.isfinite(origin)):
-        raise SolidInputError("body_origin_local", f"must be 3 finite numbers, not {body_origin_local!r}")
+        raise SolidInputError("body_origin_local",
+                              f"must be 3 finite numbers, not {body_origin_local!r}")
     vertices = np.asarray(part.mesh.vertices, dtype=float)
     local = np.asarray(part.local(phi), dtype=float)
     offsets = vertices @ local[:3, :3].T + local[:3, 3] - origin
@@ -150,9 +151,9 @@ def _winding_numbers(points, triangles):
     relative = triangles[None, :, :, :] - points[:, None, None, :]
     a, b, c = relative[..., 0, :], relative[..., 1, :], relative[..., 2, :]
     la, lb, lc = (np.linalg.norm(v, axis=-1) for v in (a, b, c))
-    numerator = np.einsum("...i,...i->...", a, np.cross(b, c))
-    denominator = (la * lb * lc + np.einsum("...i,...i->...", a, b) * lc
-                   + np.einsum("...i,...i->...", a, c) * lb + np.einsum("...i,...i->...", b, c) * la)
+    dot = lambda u, v: np.einsum("...i,...i->...", u, v)   # noqa: E731
+    numerator = dot(a, np.cross(b, c))
+    denominator = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la
     return np.arctan2(numerator, denominator).sum(axis=1) / (2.0 * math.pi)
 
 
@@ -207,7 +208,8 @@ def _shape(mesh, depth=_LEAF_DEPTH, edge_fraction=_LEAF_EDGE_FRACTION):
     model.beginModel(len(faces), len(vertices))
     model.addSubModel(vertices, faces)
     model.endModel()  # without it the first query crashes
-    components = trimesh.graph.connected_components(mesh.face_adjacency, nodes=np.arange(len(faces)))
+    components = trimesh.graph.connected_components(mesh.face_adjacency,
+                                                    nodes=np.arange(len(faces)))
     probes = np.array([vertices[faces[component[0], 0]] for component in components])
     centre, radius = _sphere(vertices)
     triangles = vertices[faces]
@@ -253,6 +255,10 @@ class FclScene:
     are visited by the gap between their spheres, nearest first, and skipped
     once that gap (a lower bound) reaches the best distance found, which leaves
     the minimum unchanged. Only the instances of the two groups are posed.
+
+    Cost, measured on the paper's planting parts (about 400 to 1,400 triangles):
+    one FCL mesh distance takes 0.1 to 1.5 ms whatever the gap, so a pose of
+    the arm-to-arm scene (9 pairs) costs 3 to 5 ms, about 1 ms of it the poses.
     """
 
     def __init__(self, assembly, group_a, group_b):
@@ -265,7 +271,8 @@ class FclScene:
             raise SolidInputError("groups", f"unknown part instances {unknown}; "
                                             f"the assembly has {sorted(instances)}")
         if not group_a or not group_b:
-            raise SolidInputError("groups", f"both groups need an instance, got {group_a} and {group_b}")
+            raise SolidInputError("groups",
+                                  f"both groups need an instance, got {group_a} and {group_b}")
         shared = sorted(set(group_a) & set(group_b))
         if shared:
             raise SolidInputError("groups", f"instances {shared} are in both groups")
@@ -283,7 +290,6 @@ class FclScene:
             self._instances[name] = (part, body, phase, shape,
                                      fcl.CollisionObject(shape.model, fcl.Transform()))
         self._pairs = [(a, b) for a in group_a for b in group_b]
-        self._poses = {}
         self.queries = 0   # poses evaluated since construction
 
     # -------------------------------------------------------------- poses
@@ -309,7 +315,7 @@ class FclScene:
 
     # -------------------------------------------------------------- queries
     def distance(self, phi: float) -> Proximity:
-        """Least distance between the groups at carrier angle ``phi`` (rad), with where it occurs."""
+        """Least distance between the groups at carrier angle ``phi`` (rad), and where it occurs."""
         import fcl
 
         phi = float(phi)
@@ -317,11 +323,15 @@ class FclScene:
             raise SolidInputError("phi", f"carrier angle must be finite, not {phi!r}")
         poses = self._place(phi)
         self.queries += 1
-        for a, b in self._pairs:   # a solid inside another: no triangles meet, FCL sees a gap
+        gaps = self._sphere_gaps(poses)
+        for index, (a, b) in enumerate(self._pairs):
+            # a solid inside another: no triangles meet and FCL sees a gap; it can only
+            # happen where the two parts' covering spheres meet
+            if gaps[index] > 0.0:
+                continue
             point = self._contained(a, b, poses)
             if point is not None:
                 return Proximity(0.0, point, point.copy(), (a, b))
-        gaps = self._sphere_gaps(poses)
         best = Proximity(math.inf, np.full(3, np.nan), np.full(3, np.nan), self._pairs[0])
         request = fcl.DistanceRequest(enable_nearest_points=True)
         for index in np.argsort(gaps, kind="stable"):
@@ -331,8 +341,8 @@ class FclScene:
             object_a, object_b = self._instances[a][4], self._instances[b][4]
             if gaps[index] <= 0.0:   # covering spheres meet: the triangles may cross
                 contact = fcl.CollisionResult()
-                if fcl.collide(object_a, object_b,
-                               fcl.CollisionRequest(num_max_contacts=1, enable_contact=True), contact):
+                asked = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
+                if fcl.collide(object_a, object_b, asked, contact):
                     point = np.array(contact.contacts[0].pos, dtype=float)
                     return Proximity(0.0, point, point.copy(), (a, b))
             result = fcl.DistanceResult()   # a reused one keeps the old minimum
@@ -354,7 +364,8 @@ class FclScene:
         gaps = np.empty(len(self._pairs))
         for index, (a, b) in enumerate(self._pairs):
             centre_gap = np.linalg.norm(world[a][:, None, :] - world[b][None, :, :], axis=-1)
-            radii = self._instances[a][3].leaf_radii[:, None] + self._instances[b][3].leaf_radii[None, :]
+            radii = (self._instances[a][3].leaf_radii[:, None]
+                     + self._instances[b][3].leaf_radii[None, :])
             gaps[index] = float((centre_gap - radii).min())
         return gaps
 
@@ -378,7 +389,7 @@ class FclScene:
         return None
 
     def distances(self, phis) -> np.ndarray:
-        """``(n,) float`` distances at carrier angles ``phis`` (n,), for :func:`certified_minimum`."""
+        """Distances ``(n,)`` at carrier angles ``phis`` ``(n,)``, for :func:`certified_minimum`."""
         phis = np.atleast_1d(np.asarray(phis, dtype=float))
         return np.array([self.distance(phi).distance for phi in phis.ravel()]).reshape(phis.shape)
 
@@ -409,9 +420,9 @@ class SweepResult:
         ``INTERFERENCE_XTOL``; an overlap that runs through ``upper`` and on from
         ``lower`` is two ranges.
     unresolved : int
-        Intervals of ``INTERFERENCE_RESOLUTION`` or less where the Lipschitz bound
-        could not rule out a brief overlap and none was sampled (see
-        :func:`certified_distance`).
+        Intervals no wider than ``resolution`` (or left when the budget ran out)
+        where the Lipschitz bound could not rule out a brief overlap and none was
+        sampled (see :func:`certified_distance`).
     samples_phi, samples_distance : (steps + 1,) float
         The screening grid and its distances, to plot distance against carrier angle.
     lipschitz, acceleration, atol : float
@@ -440,6 +451,17 @@ class SweepResult:
     @property
     def interferes(self) -> bool:
         return bool(self.interference_ranges) or self.minimum <= 0.0
+
+
+def _curvature(acceleration, lipschitz):
+    """``d'' <= A + L^2 / d`` on an interval whose first-order lower bound is ``d > 0``."""
+
+    def bound(first_order_bounds):
+        with np.errstate(divide="ignore"):
+            return np.where(first_order_bounds > 0.0,
+                            acceleration + lipschitz**2 / first_order_bounds, np.inf)
+
+    return bound
 
 
 class _Memo:
@@ -519,7 +541,7 @@ def certified_distance(scene: FclScene, *, lipschitz: float, acceleration: float
                        xtol: float = INTERFERENCE_XTOL,
                        resolution: float = INTERFERENCE_RESOLUTION,
                        max_evaluations: int = MAX_EVALUATIONS) -> SweepResult:
-    """Certified least distance between the scene's groups over ``[lower, upper]``, and interference.
+    """Certified least distance of the scene's groups over ``[lower, upper]``, and interference.
 
     Parameters
     ----------
@@ -566,6 +588,9 @@ def certified_distance(scene: FclScene, *, lipschitz: float, acceleration: float
     overlap missed there lasts less than ``resolution``. A brief separation
     inside an overlap (both ends of an interval overlapping) is not looked for:
     the parts interfere either way. When ``bound > 0`` no overlap exists at all.
+
+    The scan runs first: when it finds an overlap the minimum is 0, certified
+    (the distance is never negative), at the first overlapping pose sampled.
     """
     from kinematics.sweep import certified_minimum
 
@@ -578,30 +603,26 @@ def certified_distance(scene: FclScene, *, lipschitz: float, acceleration: float
     if not (math.isfinite(lower) and math.isfinite(upper) and upper > lower):
         raise SolidInputError("interval", f"need finite lower < upper, got [{lower!r}, {upper!r}]")
     if not (xtol > 0.0 and resolution >= xtol):
-        raise SolidInputError("xtol", f"need 0 < xtol <= resolution, got {xtol!r} and {resolution!r}")
+        raise SolidInputError("xtol",
+                              f"need 0 < xtol <= resolution, got {xtol!r} and {resolution!r}")
     start = time.perf_counter()
     lipschitz = float(lipschitz)
-    curvature = None
-    if acceleration is not None:
-        def curvature(first_order_bounds):
-            with np.errstate(divide="ignore"):
-                return np.where(first_order_bounds > 0.0,
-                                acceleration + lipschitz**2 / first_order_bounds, np.inf)
+    curvature = None if acceleration is None else _curvature(float(acceleration), lipschitz)
     memo = _Memo(scene)
-    found = certified_minimum(memo, lower, upper, steps=int(steps), lipschitz=lipschitz,
-                              curvature=curvature, atol=atol, max_evaluations=max_evaluations)
-    # certified_minimum's screening grid, posed once and cached
-    grid = np.linspace(lower, upper, int(steps) + 1)
+    grid = np.linspace(lower, upper, int(steps) + 1)   # certified_minimum's screening grid
     values = memo(grid)
     ranges, unresolved, _ = _interference(memo, grid, values, lipschitz, xtol, resolution,
                                           max_evaluations)
-    minimum, argument, bound = found.value, found.argument, found.bound
-    if ranges and minimum > 0.0:   # an overlap the minimum search did not land in
-        argument, minimum = 0.5 * (ranges[0][0] + ranges[0][1]), 0.0
-    if minimum <= 0.0:
-        bound = min(bound, 0.0)
+    if ranges:
+        # the distance is never negative: an overlap is the certified minimum, and
+        # searching on would only split the overlap down to 2 atol / L
+        minimum = bound = 0.0
+        argument = min(phi for phi, near in memo.values.items() if near.overlap)
+    else:
+        found = certified_minimum(memo, lower, upper, steps=int(steps), lipschitz=lipschitz,
+                                  curvature=curvature, atol=atol, max_evaluations=max_evaluations)
+        minimum, argument, bound = found.value, found.argument, max(found.bound, 0.0)
     near = memo.proximity(argument)
-    minimum = min(minimum, near.distance)
     return SweepResult(
         minimum=float(minimum), argument=float(argument), bound=float(bound),
         certified=bool(minimum - bound <= atol * (1.0 + 1e-9)), evaluations=len(memo.values),

@@ -1,0 +1,191 @@
+"""Collision sweep of the paper's planting assembly: certified FCL minimum against a plain scan.
+
+Run:  python -m benchmarks.sweep [--output docs/sweep.md]
+
+Two clearances of the solids, each over the carrier angle, measured in this run:
+
+* ``arm to arm``: gearbox 2, cam and planter shell of arm 1 against those of
+  arm 2 (the blades are left out: their cam-driven turn has no speed bound
+  yet). The distance repeats every half turn, so the certified search covers
+  ``[0, pi]``; the plain scan, like a peer that does not know it, covers a turn.
+* ``housings to ground``: gearbox 1 and both gearbox-2 housings against the soil
+  slab, over a turn.
+
+Methods: the certified sweep (:func:`cadgen.solids.sweep.certified_distance`,
+360 screening steps per interval, ``atol`` 1e-6 mm, speed and acceleration
+bounds from the mechanism), the plain 3,600-pose scan
+(:func:`cadgen.solids.sweep.plain_scan`), and the reference: the certified sweep
+at ``atol`` 1e-10 mm, checked against a dense scan of 2,000 poses 1e-6 rad apart
+round its argument. Errors are against the reference value. Times are wall
+times on one core, best of 3 for the certified sweep, one run otherwise; the
+scene (BVH models) is built once beforehand and timed apart.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+PARAMS = REPO / "params" / "xin2024-planter.toml"
+ARM_PARTS = ("gearbox2", "cam", "planter-shell")
+HOUSINGS = ("gearbox1", "gearbox2-arm1", "gearbox2-arm2")
+Z = (0.0, 0.0, 1.0)
+STEPS = 360
+ATOL = 1e-6
+REFERENCE_ATOL = 1e-10
+PLAIN_POSES = 3600
+
+
+def planting():
+    """The paper's design: parameters, mechanism, evaluation and its assembly (no gears)."""
+    from cadgen.cam_design import design_cam
+    from cadgen.design import build_mechanism, evaluate
+    from cadgen.params import load_params
+    from cadgen.solids.planting import planting_assembly
+
+    params = load_params(PARAMS)
+    mechanism = build_mechanism(params)
+    evaluation = evaluate(params, mechanism, steps=720)
+    cam = design_cam(params, mechanism, evaluation.events)
+    assembly, _, _ = planting_assembly(params, mechanism, None, cam, evaluation.events.soil_level)
+    return params, mechanism, evaluation, assembly
+
+
+def arm_bounds(mechanism, parts):
+    """Speed (mm/rad) and acceleration (mm/rad^2) bounds of any point of one arm's parts.
+
+    Gearbox 2 and the cam ride on gearbox 2: C circles at ``rc`` and the body
+    turns at rate 1, so ``rc + reach`` for both. The planter shell: E's bounds
+    plus its turn (rate at most ``spin``; ``spin rate + spin^2`` read off the P1
+    bound) times its reach from E.
+    """
+    from cadgen.solids.sweep import part_reach
+
+    closure, rc = mechanism.closure, mechanism.carrier_radii["C"]
+    spin = max(abs(1.0 - closure.ratio_min), abs(1.0 - closure.ratio_max))
+    turn = (mechanism.acceleration_bound("P1") - mechanism.acceleration_bound("E")) / mechanism.L1
+    box = rc + max(part_reach(parts[n], axis=Z) for n in ("gearbox2", "cam"))
+    reach = part_reach(parts["planter-shell"], axis=Z)
+    return (max(box, mechanism.speed_bound("E") + spin * reach),
+            max(box, mechanism.acceleration_bound("E") + turn * reach))
+
+
+def cases(mechanism, assembly):
+    """``[(label, scene, lipschitz, acceleration, upper)]`` of the two clearances."""
+    from cadgen.solids.sweep import FclScene, part_reach
+
+    parts = {part.name: part for part in assembly.parts}
+    speed, acceleration = arm_bounds(mechanism, parts)
+    rc = mechanism.carrier_radii["C"]
+    ground_speed = max(part_reach(parts["gearbox1"], axis=Z),
+                       rc + part_reach(parts["gearbox2"], axis=Z))
+    out = []
+    start = time.perf_counter()
+    arms = FclScene(assembly, [f"{n}-arm1" for n in ARM_PARTS], [f"{n}-arm2" for n in ARM_PARTS])
+    out.append(("arm to arm", arms, 2 * speed, 2 * acceleration, math.pi,
+                time.perf_counter() - start))
+    start = time.perf_counter()
+    ground = FclScene(assembly, HOUSINGS, ["ground"])
+    out.append(("housings to ground", ground, ground_speed, ground_speed, 2 * math.pi,
+                time.perf_counter() - start))
+    return out
+
+
+def _timed(function, repeat=1):
+    best, value = math.inf, None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        value = function()
+        best = min(best, time.perf_counter() - start)
+    return value, best
+
+
+def measure(label, scene, lipschitz, acceleration, upper, build_seconds):
+    """One clearance: every figure of its table rows, as a dict."""
+    from cadgen.solids.sweep import certified_distance, plain_scan
+
+    def sweep(atol):
+        return certified_distance(scene, lipschitz=lipschitz, acceleration=acceleration,
+                                  steps=STEPS, atol=atol, upper=upper)
+
+    reference, reference_seconds = _timed(lambda: sweep(REFERENCE_ATOL))
+    window = reference.argument + np.linspace(-1e-3, 1e-3, 2000)   # the argument itself left out
+    dense = float(scene.distances(window).min())
+    certified, certified_seconds = _timed(lambda: sweep(ATOL), repeat=3)
+    (plain, plain_argument), plain_seconds = _timed(lambda: plain_scan(scene, PLAIN_POSES))
+    print(f"{label}: reference {reference.minimum:.12f} mm (bound {reference.bound:.12f}, "
+          f"{reference.evaluations} poses, {reference_seconds:.2f} s); dense window "
+          f"{dense:.12f}; certified {certified.minimum:.12f} ({certified.evaluations} poses, "
+          f"{certified_seconds:.2f} s); plain {plain:.12f} ({plain_seconds:.2f} s)", flush=True)
+    return dict(label=label, lipschitz=lipschitz, acceleration=acceleration, upper=upper,
+                build_seconds=build_seconds, reference=reference,
+                reference_seconds=reference_seconds, dense=dense, certified=certified,
+                certified_seconds=certified_seconds, plain=plain, plain_argument=plain_argument,
+                plain_seconds=plain_seconds)
+
+
+def markdown(results=None) -> list:
+    """The tables of ``docs/sweep.md`` as lines (measures first when ``results`` is None)."""
+    if results is None:
+        _, mechanism, _, assembly = planting()
+        results = [measure(*case) for case in cases(mechanism, assembly)]
+    lines = ["## Collision sweep of the solids (python-fcl)", "",
+             "Generated by `python -m benchmarks.sweep` (do not edit by hand). The paper's "
+             "planting assembly (`params/xin2024-planter.toml`, no gears: they lie inside the "
+             "housings). "
+             f"Certified: {STEPS} screening steps over the interval, atol {ATOL:g} mm, bounds on "
+             "the relative speed and acceleration from the mechanism. Plain: "
+             f"{PLAIN_POSES} evenly spaced poses over a turn, no refinement. Reference: the "
+             f"certified sweep at atol {REFERENCE_ATOL:g} mm. Arm to arm: gearbox 2, cam and "
+             "planter shell of each arm (blades left out: no bound on their cam-driven turn "
+             "yet), searched over [0, pi] (the distance repeats every half turn). Times: wall, "
+             "one core, best of 3 for the certified sweep.", "",
+             "| clearance | method | minimum (mm) | error vs reference (mm) | certified bound (mm) "
+             "| poses | time (s) | time vs certified |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r in results:
+        reference, certified = r["reference"], r["certified"]
+        base = r["certified_seconds"]
+        rows = [("certified", certified.minimum, f"{certified.bound:.9f}", certified.evaluations,
+                 base),
+                (f"plain {PLAIN_POSES}-pose scan", r["plain"], "none", PLAIN_POSES,
+                 r["plain_seconds"]),
+                (f"reference (atol {REFERENCE_ATOL:g})", reference.minimum,
+                 f"{reference.bound:.12f}", reference.evaluations, r["reference_seconds"])]
+        for method, value, bound, poses, seconds in rows:
+            lines.append(f"| {r['label']} | {method} | {value:.12f} | "
+                         f"{abs(value - reference.minimum):.1e} | {bound} | {poses} | "
+                         f"{seconds:.3f} | {seconds / base:.1f} |")
+    lines += ["", "| clearance | L (mm/rad) | A (mm/rad^2) | where (deg) | nearest pair | "
+              "dense window - reference (mm) | scene build (s) |",
+              "|---|---:|---:|---:|---|---:|---:|"]
+    for r in results:
+        reference = r["reference"]
+        lines.append(f"| {r['label']} | {r['lipschitz']:.1f} | {r['acceleration']:.1f} | "
+                     f"{math.degrees(reference.argument):.6f} | {reference.pair[0]} - "
+                     f"{reference.pair[1]} | {r['dense'] - reference.minimum:.1e} | "
+                     f"{r['build_seconds']:.2f} |")
+    lines += ["", "Dense window: 2,000 poses 1e-6 rad apart round (not on) the reference's "
+              "argument, through the same scene; it can only lie above the true minimum, so a "
+              "small non-negative difference confirms the reference. The plain scan has no bound: "
+              "its error is what sampling alone leaves between samples."]
+    return lines
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--output", type=Path, default=REPO / "docs" / "sweep.md")
+    args = parser.parse_args(argv)
+    lines = ["# Collision sweep: accuracy against time", ""] + markdown()[2:] + [""]
+    print("\n".join(lines))
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    args.output.write_text("\n".join(lines), encoding="utf-8")
+    print(f"wrote {args.output}")
+
+
+if __name__ == "__main__":
+    main()

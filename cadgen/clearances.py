@@ -1,0 +1,173 @@
+"""The clearances of the solids through a revolution (FCL): arm against arm, housings against ground.
+
+Each is a certified least distance (:func:`cadgen.solids.sweep.certified_distance`)
+from the speed and acceleration bounds of the moving bodies, per radian of carrier
+angle (see that module for the formula ``v + w * reach + u``):
+
+* gearbox 2 and the cam ride on gearbox 2, whose origin C circles at ``Rc`` while
+  the body turns at rate 1: points move at most ``Rc + reach`` (acceleration the same);
+* the planter shell rides on the planter: E's bounds plus its turn (rate at most
+  ``max |1 - i|``, angular term read off the planting model's P1 bound) times its
+  reach from E;
+* a blade also turns on its hinge by the cam's law. Its rate and acceleration
+  there are the largest over 20,000 samples of the revolution plus 25 % (the law
+  is smooth: cycloidal or 3-4-5), times its reach from the hinge, with the
+  Coriolis term ``2 w beta'``;
+* gearbox 1 turns about O at rate 1; the ground is fixed.
+
+The pair's bound is the sum of the two groups' (arm 2 moves like arm 1). The
+result replaces the kinematic estimate (centre lines, envelope circles) of the
+metric; the report keeps both.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
+
+#: Parts of one planting arm (instances carry ``-arm1`` / ``-arm2``).
+ARM_PARTS = ("gearbox2", "cam", "planter-shell", "blade-right", "blade-left")
+#: The certified minimum is within this of the true one (mm).
+SWEEP_ATOL = 1e-6
+#: Screening steps per sweep: the second-order screen needs few (benchmarks/sweep.py).
+SWEEP_STEPS = 90
+#: Margin on sampled blade rates (see the module notes).
+SAMPLED_MARGIN = 1.25
+_Z = (0.0, 0.0, 1.0)
+
+
+def _planter_turn(mechanism):
+    closure = mechanism.closure
+    spin = max(abs(1.0 - closure.ratio_min), abs(1.0 - closure.ratio_max))
+    turn = (mechanism.acceleration_bound("P1") - mechanism.acceleration_bound("E")) / mechanism.L1
+    return spin, turn
+
+
+def _blade_rates(cam, mechanism, samples: int = 20_000):
+    """Largest |d beta/d phi| and |d2 beta/d phi2| of the blades over a revolution (sampled, +25 %)."""
+    phi = np.linspace(0.0, 2 * np.pi, samples + 1)
+    lam = cam.profile.program(cam.cam_angle(phi))[0]
+    beta = cam.linkage.opening_of_lever(lam)
+    step = phi[1] - phi[0]
+    rate = np.gradient(beta, step)
+    return (SAMPLED_MARGIN * float(np.max(np.abs(rate))),
+            SAMPLED_MARGIN * float(np.max(np.abs(np.gradient(rate, step)))))
+
+
+def _arm_bounds(mechanism, parts, cam):
+    """(speed, acceleration) bounds of any point of one arm's parts that are present."""
+    from .solids.sweep import part_reach
+
+    rc = mechanism.carrier_radii["C"]
+    spin, turn = _planter_turn(mechanism)
+    speed, acceleration = [], []
+    for name in ("gearbox2", "cam"):
+        if name in parts:
+            box = rc + part_reach(parts[name], axis=_Z)
+            speed.append(box)
+            acceleration.append(box)
+    if "planter-shell" in parts:
+        reach = part_reach(parts["planter-shell"], axis=_Z)
+        speed.append(mechanism.speed_bound("E") + spin * reach)
+        acceleration.append(mechanism.acceleration_bound("E") + turn * reach)
+    blades = [parts[n] for n in ("blade-right", "blade-left") if n in parts]
+    if blades:
+        rate, rate_rate = _blade_rates(cam, mechanism) if cam is not None else (0.0, 0.0)
+        for blade in blades:
+            # its reach from E changes as it opens: the largest over the opening
+            reach_e = max(part_reach(blade, axis=_Z, phi=phi)
+                          for phi in np.linspace(0, 2 * np.pi, 13))
+            pivot = _hinge_point(blade)
+            reach_h = part_reach(blade, body_origin_local=(*pivot, 0.0), axis=_Z)
+            speed.append(mechanism.speed_bound("E") + spin * reach_e + rate * reach_h)
+            acceleration.append(mechanism.acceleration_bound("E") + turn * reach_e
+                                + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
+    return max(speed), max(acceleration)
+
+
+def _hinge_point(blade) -> np.ndarray:
+    """The fixed point of a blade's turn in the planter frame (where local(phi) leaves it be)."""
+    a, b = blade.local(0.0), blade.local(np.pi + 0.3)
+    # solve (A - B) p = t_B - t_A for the point both poses map alike (fall back to the origin)
+    rotation = a[:2, :2] - b[:2, :2]
+    if abs(np.linalg.det(rotation)) < 1e-12:
+        return np.array([0.0, 0.0])
+    return np.linalg.solve(rotation, b[:2, 3] - a[:2, 3])
+
+
+def _section(result, label, target, kinematic) -> dict:
+    return {
+        "label": label, "method": "FCL mesh distance of the solids, certified minimum",
+        "minimum_mm": float(result.minimum), "certified_bound_mm": float(result.bound),
+        "certified": bool(result.certified),
+        "carrier_angle_deg": float(np.degrees(result.argument)),
+        "nearest": [str(result.pair[0]), str(result.pair[1])],
+        "nearest_points_mm": [np.asarray(result.point_a, dtype=float).tolist(),
+                              np.asarray(result.point_b, dtype=float).tolist()],
+        "interference_ranges_deg": [[float(np.degrees(a)), float(np.degrees(b))]
+                                    for a, b in result.interference_ranges],
+        "kinematic_estimate_mm": None if kinematic is None else float(kinematic),
+        "target_mm": float(target),
+        "passed": bool(result.minimum > target and not result.interference_ranges),
+        "evaluations": int(result.evaluations),
+        "lipschitz_mm_per_rad": float(result.lipschitz),
+        "atol_mm": float(result.atol),
+        "samples": {"carrier_angle_deg": np.degrees(result.samples_phi).round(6).tolist(),
+                    "distance_mm": np.asarray(result.samples_distance).round(6).tolist()},
+    }
+
+
+def _kinematic(evaluation, key):
+    return next(m.value for m in evaluation.metrics if m.key == key)
+
+
+def arm_interference(params, mechanism, solids, cam) -> dict:
+    """Certified least distance between the two planting arms' solids over a revolution."""
+    from .solids.sweep import FclScene, certified_distance
+
+    assembly = solids.assembly
+    parts = {part.name: part for part in assembly.parts}
+    present = [name for name in ARM_PARTS if name in parts]
+    scene = FclScene(assembly, [f"{n}-arm1" for n in present], [f"{n}-arm2" for n in present])
+    speed, acceleration = _arm_bounds(mechanism, parts, cam)
+    # arm 2 is arm 1 half a turn on, so the distance repeats every half turn
+    result = certified_distance(scene, lipschitz=2 * speed, acceleration=2 * acceleration,
+                                upper=math.pi, atol=SWEEP_ATOL, steps=SWEEP_STEPS)
+    kinematic = _arm_distance_estimate(params, mechanism)
+    return _section(result, "arm distance (solids, FCL)", params.targets.arm_distance_min,
+                    kinematic)
+
+
+def _arm_distance_estimate(params, mechanism):
+    from kinematics.clearance import arm_distance
+
+    return arm_distance(mechanism, steps=params.resolution.steps_per_revolution).value
+
+
+def ground_clearance(params, design, solids, field) -> dict:
+    """Certified least gap between every housing and the ground mesh over a revolution."""
+    from .solids.sweep import FclScene, certified_distance, part_reach
+
+    assembly = solids.assembly
+    parts = {part.name: part for part in assembly.parts}
+    if params.mechanism == "pricking":
+        link = design.linkage
+        housings = ["gear-case"]
+        # the case turns about O at rate 1 (a point of it moves at most its reach from O)
+        centre = (*np.asarray(link.centre, dtype=float), 0.0)
+        speed = part_reach(parts["gear-case"], body_origin_local=centre, axis=_Z)
+        result = certified_distance(FclScene(assembly, housings, ["ground"]), lipschitz=speed,
+                                    acceleration=speed, atol=SWEEP_ATOL, steps=SWEEP_STEPS)
+        # the case must stay out of the soil (no kinematic estimate for this mechanism)
+        return _section(result, "gear case ground clearance (solids, FCL)", 0.0, None)
+    rc = design.carrier_radii["C"]
+    housings = ["gearbox1", "gearbox2-arm1", "gearbox2-arm2"]
+    speed = max(part_reach(parts["gearbox1"], axis=_Z), rc + part_reach(parts["gearbox2"], axis=_Z))
+    scene = FclScene(assembly, housings, ["ground"])
+    result = certified_distance(scene, lipschitz=speed, acceleration=speed, atol=SWEEP_ATOL,
+                                steps=SWEEP_STEPS)
+    return _section(result, "gearbox ground clearance (solids, FCL)",
+                    params.targets.ground_clearance_min, _kinematic(field, "ground_clearance"))
