@@ -7,12 +7,6 @@ and ``cadgen --help`` do not pay for pydantic, numpy or the geometry engines.
 from __future__ import annotations
 
 from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("cadgen")
-except PackageNotFoundError:  # running from a source tree that was never installed
-    __version__ = "0.0.0+unknown"
 
 _EXPORTS = {
     "ParameterError": "cadgen.params",
@@ -26,12 +20,26 @@ _EXPORTS = {
     "write_bytes_atomic": "cadgen.atomic",
     "write_text_atomic": "cadgen.atomic",
     "staged_directory": "cadgen.atomic",
+    "build": "cadgen.build",
 }
 
 __all__ = ["__version__", *_EXPORTS]
 
 
+def _version() -> str:
+    # importlib.metadata costs 35 ms to import: read it only when the version is asked for
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("cadgen")
+    except PackageNotFoundError:  # running from a source tree that was never installed
+        return "0.0.0+unknown"
+
+
 def __getattr__(name: str):
+    if name == "__version__":
+        globals()["__version__"] = value = _version()
+        return value
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'cadgen' has no attribute {name!r}")

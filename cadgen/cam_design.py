@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
+from kinematics.scalar import brentq
 
 from kinematics.cam import CamCheck, CamProfile, CamTiming, cam_timing
 from kinematics.duckbill import DuckbillLinkage

@@ -17,8 +17,13 @@ __all__ = ["build_mechanism", "targets_of", "evaluate", "pricking_design",
            "pricking_field"]
 
 
+@lru_cache(maxsize=16)
 def build_mechanism(params) -> PlantingMechanism:
-    """The :class:`~kinematics.planting.PlantingMechanism` a validated parameter model describes."""
+    """The :class:`~kinematics.planting.PlantingMechanism` a validated parameter model describes.
+
+    Cached (the parameters are frozen): validation's feasibility checks and the
+    build share one mechanism, so its closure is solved once.
+    """
     curve = params.pitch_curve
     train = params.train
     return PlantingMechanism(

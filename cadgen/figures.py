@@ -1,43 +1,98 @@
-"""The pictures of a build: one PNG per view of what its stages made (matplotlib, Agg)."""
+"""The pictures of a build: one PNG per view of what its stages made (matplotlib, Agg).
+
+Drawing is the slowest part of a full build on a small machine (a dozen
+figures). Where the platform can fork, half of the figures are drawn in a forked
+worker while this process draws the rest: the worker inherits every computed
+result, so nothing is pickled on the way in, only PNG bytes on the way back.
+The bytes are the same either way (each figure is drawn on its own).
+"""
 
 from __future__ import annotations
 
+import multiprocessing
+import os
+
 import numpy as np
 
-__all__ = ["build_figures"]
+__all__ = ["build_figures", "figure_jobs"]
+
+#: Jobs the forked worker draws, set just before it is forked (it inherits them).
+_WORKER_JOBS: dict = {}
 
 
-def build_figures(run) -> dict:
-    """``{file name: PNG bytes}`` for every stage that ran: paths, gears, cam, solids, sweeps."""
+def figure_jobs(run) -> dict:
+    """``{file name: callable -> PNG bytes}`` for every stage that ran."""
     ok = {r.stage for r in run.records if r.status == "ok"}
     values, params = run.values, run.params
-    figures = {}
+    jobs = {}
     if params.mechanism == "pricking":
         if {"kinematics", "metrics"} <= ok:
-            from .plots_pricking import pricking_figures
+            from .plots_pricking import pricking_figure_jobs
 
-            figures.update(pricking_figures(params, values["kinematics"], values["metrics"]))
+            jobs.update(pricking_figure_jobs(params, values["kinematics"], values["metrics"]))
     elif "metrics" in ok:
-        from .plots import planting_figures
+        from .plots import planting_figure_jobs
 
-        figures.update(planting_figures(values["kinematics"], values["metrics"]))
+        jobs.update(planting_figure_jobs(values["kinematics"], values["metrics"]))
     if "teeth" in ok and values["teeth"].stages:
-        from .gear_trains import pair_figures
+        from .gear_trains import pair_figure_jobs
 
-        figures.update(pair_figures(values["teeth"]))
+        jobs.update(pair_figure_jobs(values["teeth"]))
     if "cam" in ok:
-        from .plots_cam import cam_figures
+        from .plots_cam import cam_figure_jobs
 
-        figures.update(cam_figures(values["cam"], params.cam.profile_points))
+        jobs.update(cam_figure_jobs(values["cam"], params.cam.profile_points))
     if "parts" in ok:
-        figures["assembly.png"] = _assembly(run)
+        jobs["assembly.png"] = lambda: _assembly(run)
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:
         from .plots_sweep import clearance_figure
 
-        figures["clearance.png"] = clearance_figure(sweeps)
-    run.figures = figures
+        jobs["clearance.png"] = lambda: clearance_figure(sweeps)
+    return jobs
+
+
+def build_figures(run, *, parallel: bool | None = None) -> dict:
+    """Draw every figure of a run (half of them in a forked worker where that helps)."""
+    jobs = figure_jobs(run)
+    if parallel is None:
+        parallel = _can_fork() and len(jobs) >= 4
+    if not parallel:
+        figures = {name: draw() for name, draw in jobs.items()}
+    else:
+        figures = _draw_in_two(jobs)
+    run.figures = {name: figures[name] for name in jobs}   # the jobs' order, whoever drew
+    return run.figures
+
+
+def _can_fork() -> bool:
+    return (os.cpu_count() or 1) > 1 and "fork" in multiprocessing.get_all_start_methods()
+
+
+def _draw_in_two(jobs: dict) -> dict:
+    from concurrent.futures import ProcessPoolExecutor
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401  (imported once, before the fork, for both)
+
+    names = list(jobs)
+    theirs = names[1::2]
+    _WORKER_JOBS.clear()
+    _WORKER_JOBS.update({name: jobs[name] for name in theirs})
+    try:
+        with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
+            future = pool.submit(_draw_worker_jobs)
+            figures = {name: jobs[name]() for name in names[0::2]}
+            figures.update(future.result())
+    finally:
+        _WORKER_JOBS.clear()
     return figures
+
+
+def _draw_worker_jobs() -> dict:
+    return {name: draw() for name, draw in _WORKER_JOBS.items()}
 
 
 def _assembly(run) -> bytes:

@@ -24,7 +24,7 @@ from .meshing import meshing_check, relieve_interference
 from .teeth import ToothSystem
 
 __all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "pricking_train", "circular_module",
-           "write_train_files", "train_report", "pair_figures"]
+           "write_train_files", "train_report", "pair_figures", "pair_figure_jobs"]
 
 
 @dataclass(frozen=True)
@@ -240,28 +240,36 @@ def train_report(train: GearTrain) -> dict:
     return {"gears": gears, "meshes": meshes, "failures": failures}
 
 
+def pair_figure_jobs(train: GearTrain) -> dict:
+    """``{file name: callable -> PNG bytes}``: a picture of each pair at the start position."""
+    jobs = {}
+    for index, stage in enumerate(train.stages):
+        slug = re.sub(r"[^a-z0-9]+", "-", stage.name.lower()).strip("-")
+        jobs[f"gears-{index + 1}-{slug}.png"] = lambda stage=stage: _pair_figure(stage)
+    return jobs
+
+
 def pair_figures(train: GearTrain) -> dict:
-    """A picture of each pair at the start position, problem teeth marked (PNG bytes)."""
+    """A picture of each pair at the start position (PNG bytes, keyed by file name)."""
+    return {name: draw() for name, draw in pair_figure_jobs(train).items()}
+
+
+def _pair_figure(stage) -> bytes:
     from .plots import _figure, _fill, _png
 
-    figures = {}
-    for index, stage in enumerate(train.stages):
-        figure, ax = _figure(8.0, 5.0)
-        pair = stage.generated.pair
-        rotations = pair.rotations(np.array([0.0]))
-        for k, (profile, check) in enumerate(zip(stage.generated.profiles,
-                                                 stage.generated.checks)):
-            outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
-            _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
-                    f"({profile.teeth} teeth, {check.cutter})")
-            ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
-        m = stage.meshing
-        ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
-                     f"{m.interference_poses} interfering poses of {m.poses}, "
-                     f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
-        ax.set_aspect("equal")
-        ax.legend(fontsize=7, loc="upper right")
-        ax.grid(alpha=0.2)
-        slug = re.sub(r"[^a-z0-9]+", "-", stage.name.lower()).strip("-")
-        figures[f"gears-{index + 1}-{slug}.png"] = _png(figure)
-    return figures
+    figure, ax = _figure(8.0, 5.0)
+    pair = stage.generated.pair
+    rotations = pair.rotations(np.array([0.0]))
+    for k, (profile, check) in enumerate(zip(stage.generated.profiles, stage.generated.checks)):
+        outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
+        _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
+              f"({profile.teeth} teeth, {check.cutter})")
+        ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
+    m = stage.meshing
+    ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
+                 f"{m.interference_poses} interfering poses of {m.poses}, "
+                 f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
+    ax.set_aspect("equal")
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.2)
+    return _png(figure)

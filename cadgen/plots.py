@@ -6,7 +6,7 @@ import io
 
 import numpy as np
 
-__all__ = ["planting_figures"]
+__all__ = ["planting_figures", "planting_figure_jobs"]
 
 
 def _figure(width=7.5, height=5.0, **layout):
@@ -167,13 +167,19 @@ def pitch_curves(mechanism, evaluation, samples=1440):
     return _png(figure)
 
 
-def planting_figures(mechanism, evaluation, samples: int = 1441) -> dict:
-    """PNG bytes of every plot of a planting design, keyed by file name."""
+def planting_figure_jobs(mechanism, evaluation, samples: int = 1441) -> dict:
+    """``{file name: callable -> PNG bytes}`` of every plot of a planting design."""
     phi = np.linspace(0.0, 2 * np.pi, samples)
     return {
-        "relative_path.png": relative_path(mechanism, evaluation, phi),
-        "absolute_paths.png": absolute_paths(mechanism, evaluation, phi),
-        "attitude.png": attitude(mechanism, evaluation, phi),
-        "tip_velocity.png": velocity(mechanism, evaluation, phi),
-        "pitch_curves.png": pitch_curves(mechanism, evaluation),
+        "relative_path.png": lambda: relative_path(mechanism, evaluation, phi),
+        "absolute_paths.png": lambda: absolute_paths(mechanism, evaluation, phi),
+        "attitude.png": lambda: attitude(mechanism, evaluation, phi),
+        "tip_velocity.png": lambda: velocity(mechanism, evaluation, phi),
+        "pitch_curves.png": lambda: pitch_curves(mechanism, evaluation),
     }
+
+
+def planting_figures(mechanism, evaluation, samples: int = 1441) -> dict:
+    """PNG bytes of every plot of a planting design, keyed by file name."""
+    return {name: draw() for name, draw in
+            planting_figure_jobs(mechanism, evaluation, samples).items()}

@@ -6,7 +6,7 @@ import numpy as np
 
 from .plots import _figure, _fill, _png
 
-__all__ = ["cam_figures"]
+__all__ = ["cam_figures", "cam_figure_jobs"]
 
 _EVENT_STYLE = {"entry": "tab:brown", "lowest": "k", "exit": "tab:brown",
                 "seedling_cleared": "tab:green"}
@@ -76,5 +76,11 @@ def contour(design, points: int) -> bytes:
     return _png(figure)
 
 
+def cam_figure_jobs(design, points: int) -> dict:
+    """``{file name: callable -> PNG bytes}`` of the cam's two pictures."""
+    return {"cam-follower.png": lambda: follower_motion(design),
+            "cam-contour.png": lambda: contour(design, points)}
+
+
 def cam_figures(design, points: int) -> dict:
-    return {"cam-follower.png": follower_motion(design), "cam-contour.png": contour(design, points)}
+    return {name: draw() for name, draw in cam_figure_jobs(design, points).items()}

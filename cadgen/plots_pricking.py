@@ -130,7 +130,13 @@ def field_paths(design, field, params):
     return _png(figure)
 
 
+def pricking_figure_jobs(params, design, field) -> dict:
+    """``{file name: callable -> PNG bytes}`` of every plot of a pricking design."""
+    return {"loop.png": lambda: loop(design), "pitch_curves.png": lambda: pitch_curves(design),
+            "ratio.png": lambda: ratio(design),
+            "field_paths.png": lambda: field_paths(design, field, params)}
+
+
 def pricking_figures(params, design, field) -> dict:
     """PNG bytes of every plot of a pricking design, keyed by file name."""
-    return {"loop.png": loop(design), "pitch_curves.png": pitch_curves(design),
-            "ratio.png": ratio(design), "field_paths.png": field_paths(design, field, params)}
+    return {name: draw() for name, draw in pricking_figure_jobs(params, design, field).items()}

@@ -199,7 +199,7 @@ def _shaper_tooth(system: ToothSystem, teeth: int, flank_points: int, fillet_poi
     rounded with ``tip_radius`` tangent to flank and tip circle; the flank runs
     down to the base circle or the cutter's own root, whichever is higher.
     """
-    from scipy.optimize import brentq
+    from kinematics.scalar import brentq
 
     m, alpha = system.module, system.pressure_angle
     radius = teeth * m / 2

@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
+from .scalar import brentq, minimize_scalar
 
 from .duckbill import DuckbillLinkage
 from .errors import DesignError, Problem

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.optimize import brentq
+from .scalar import brentq
 
 from . import tolerances as tol
 from .errors import DesignError, Problem

@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
+from .scalar import brentq, minimize_scalar
 
 from .errors import ConvergenceError, DesignError, Problem
 from . import tolerances as tol

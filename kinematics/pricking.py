@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
+from .scalar import brentq
 
 from .chebyshev import PiecewiseChebyshev
 from .errors import ConvergenceError, DesignError, Problem
@@ -594,7 +594,7 @@ def _ratio_extreme(geometry: _StageGeometry, sign: float = 1.0, per_piece: int =
     Dense samples on every interpolation piece, then Brent round the four most
     extreme local extrema: a narrow peak between samples is not missed.
     """
-    from scipy.optimize import minimize_scalar
+    from .scalar import minimize_scalar
 
     breaks = geometry.ratio.breaks
     local = (np.arange(per_piece) + 0.5) / per_piece

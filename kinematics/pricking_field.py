@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
+from .scalar import brentq, minimize_scalar
 
 from .errors import DesignError, Problem
 from .pricking import PrickingDesign

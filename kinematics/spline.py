@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
-from scipy.optimize import minimize_scalar
+from .scalar import minimize_scalar
 
 from .errors import DesignError, Problem
 from .planar import cross as _cross
@@ -189,7 +189,7 @@ class ClosedCurve:
         the slope has a simple root there, which bisection finds to round-off
         (the dead centres must be exact: the branch of the arccos flips there).
         """
-        from scipy.optimize import brentq
+        from .scalar import brentq
 
         def slope(u):
             return float(np.dot(self(u) - centre, self(u, 1)))

@@ -162,3 +162,17 @@ def test_sweeps_replace_the_kinematic_estimates_and_keep_them_beside(params):
         ground["kinematic_estimate_mm"] + 1e-6
     assert [s["stage"] for s in report["stages"]] == [
         "kinematics", "metrics", "cam", "parts", "arm_interference", "ground_clearance"]
+
+
+def test_figures_drawn_in_a_forked_worker_are_the_same_bytes(params):
+    from cadgen.figures import _can_fork, build_figures
+
+    if not _can_fork():
+        pytest.skip("this platform cannot fork")
+    result = cadgen.build._Build(params, ["kinematics", "metrics", "cam"], None)
+    result.effects, result.case = ["cam"], "field"
+    result.run(cadgen.build.STAGE_FUNCTIONS)
+    together = build_figures(result, parallel=True)
+    alone = build_figures(result, parallel=False)
+    assert list(together) == list(alone) and len(together) == 7
+    assert all(together[name] == alone[name] for name in alone)
