@@ -64,8 +64,8 @@ EFFECT_STAGES = {
 STAGE_NEEDS = {
     "kinematics": (),
     "metrics": ("kinematics",),
-    "teeth": ("kinematics",),
     "cam": ("metrics",),
+    "teeth": ("kinematics",),
     "parts": ("metrics",),
     "arm_interference": ("parts",),
     "ground_clearance": ("parts",),
@@ -161,28 +161,85 @@ class _Build:
         return next((r.status for r in self.records if r.stage == stage), "not run")
 
     def run(self, functions: dict) -> None:
+        ahead = None
         for stage in self.stages:
+            if stage == "teeth" and ahead is None:
+                ahead = _start_sweeps_ahead(self, functions)
             failed = [need for need in STAGE_NEEDS[stage]
                       if need in self.stages and self.status(need) != "ok"]
             if failed:
                 self.records.append(StageRecord(stage, "skipped", message=(
                     f"needs {', '.join(failed)}, which did not complete")))
                 continue
-            start = time.perf_counter()
-            try:
-                self.values[stage] = functions[stage](self)
-            except (DesignError, ConvergenceError) as error:
-                problems = [{"path": p.path, "code": p.code, "message": p.message}
-                            for p in getattr(error, "problems", [])]
-                message = "; ".join(f"[{p['code']}] {p['message']}" for p in problems) or str(error)
-                self.records.append(StageRecord(stage, "failed", time.perf_counter() - start,
-                                                message, problems))
+            if ahead is not None and stage in SWEEP_STAGES:
+                record, value = ahead.result()[stage]
+                self.records.append(record)
+                if record.status == "ok":
+                    self.values[stage] = value
                 continue
-            except MechanismError as error:
-                self.records.append(StageRecord(stage, "failed", time.perf_counter() - start,
-                                                f"{type(error).__name__}: {error}"))
-                continue
-            self.records.append(StageRecord(stage, "ok", time.perf_counter() - start))
+            record, value = _run_stage(self, stage, functions)
+            self.records.append(record)
+            if record.status == "ok":
+                self.values[stage] = value
+
+
+def _run_stage(run, stage: str, functions: dict):
+    """Run one stage: ``(StageRecord, value)``; a design or model error fails the stage only."""
+    start = time.perf_counter()
+    try:
+        value = functions[stage](run)
+    except (DesignError, ConvergenceError) as error:
+        problems = [{"path": p.path, "code": p.code, "message": p.message}
+                    for p in getattr(error, "problems", [])]
+        message = "; ".join(f"[{p['code']}] {p['message']}" for p in problems) or str(error)
+        return StageRecord(stage, "failed", time.perf_counter() - start, message, problems), None
+    except MechanismError as error:
+        return StageRecord(stage, "failed", time.perf_counter() - start,
+                           f"{type(error).__name__}: {error}"), None
+    return StageRecord(stage, "ok", time.perf_counter() - start), value
+
+
+#: The FCL sweeps, which need the solids but not the gears: on a machine that can fork they
+#: run in a worker on a gearless assembly while this process cuts the teeth (same results:
+#: no gear is in a sweep).
+SWEEP_STAGES = ("arm_interference", "ground_clearance")
+_AHEAD: dict = {}
+
+
+def _start_sweeps_ahead(run, functions):
+    import multiprocessing
+    import os
+
+    sweeps = [s for s in SWEEP_STAGES if s in run.stages]
+    if (not sweeps or "teeth" not in run.stages or (os.cpu_count() or 1) < 2
+            or "fork" not in multiprocessing.get_all_start_methods()
+            or any(run.status(need) != "ok" for need in ("metrics",))):
+        return None
+    from concurrent.futures import ProcessPoolExecutor
+
+    _AHEAD.update(run=run, functions=functions, sweeps=sweeps)
+    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
+    future = pool.submit(_sweeps_ahead)
+    pool.shutdown(wait=False)   # the worker ends after its one task
+    _AHEAD.clear()              # the forked worker has its own copy
+    return future
+
+
+def _sweeps_ahead() -> dict:
+    """In the forked worker: the gearless parts, then each sweep; ``{stage: (record, value)}``."""
+    run, functions, sweeps = _AHEAD["run"], _AHEAD["functions"], _AHEAD["sweeps"]
+    parts_record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
+    out = {}
+    for stage in sweeps:
+        if parts_record.status != "ok":
+            out[stage] = (StageRecord(stage, "skipped", message="needs parts, which did not "
+                                                                "complete"), None)
+            continue
+        run.values["parts"] = parts
+        record, value = _run_stage(run, stage, functions)
+        record.message = record.message or "ran beside the teeth, in a second process"
+        out[stage] = (record, value)
+    return out
 
 
 # --------------------------------------------------------------------------- stages
@@ -224,11 +281,15 @@ def _cam(run):
     return design_cam(run.params, run.values["kinematics"], run.values["metrics"].events)
 
 
-def _parts(run):
+def _gearless_parts(run):
+    return _parts(run, gears=False)
+
+
+def _parts(run, gears: bool = True):
     from .solids.stage import solids_outcome
 
     params = run.params
-    train = run.values.get("teeth") if run.status("teeth") == "ok" else None
+    train = run.values.get("teeth") if gears and run.status("teeth") == "ok" else None
     if params.mechanism == "pricking":
         from .solids.pricking import pricking_assembly
 

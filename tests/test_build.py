@@ -27,7 +27,7 @@ def params():
     (["curves"], ["kinematics"]),
     (["teeth"], ["kinematics", "teeth"]),
     (["cam"], ["kinematics", "metrics", "cam"]),
-    (["dxf"], ["kinematics", "metrics", "teeth", "cam"]),
+    (["dxf"], ["kinematics", "metrics", "cam", "teeth"]),
     (["arm_interference"], ["kinematics", "metrics", "cam", "parts", "arm_interference"]),
     (["ground_clearance"], ["kinematics", "metrics", "parts", "ground_clearance"]),
     (["plots"], ["kinematics", "plots"]),
@@ -176,3 +176,17 @@ def test_figures_drawn_in_a_forked_worker_are_the_same_bytes(params):
     alone = build_figures(result, parallel=False)
     assert list(together) == list(alone) and len(together) == 7
     assert all(together[name] == alone[name] for name in alone)
+
+
+def test_sweeps_run_beside_the_teeth_give_the_same_clearances(params):
+    """With teeth to cut, the sweeps run in a forked worker on a gearless assembly."""
+    from cadgen.figures import _can_fork
+
+    if not _can_fork():
+        pytest.skip("this platform cannot fork")
+    beside = build(params, None, effects=["teeth", "arm_interference", "ground_clearance"])
+    alone = build(params, None, effects=["arm_interference", "ground_clearance"])
+    stages = {s["stage"]: s for s in beside.report["stages"]}
+    assert "second process" in stages["arm_interference"]["message"]
+    for key in ("arm_interference", "ground_clearance"):
+        assert beside.report["sweep"][key] == alone.report["sweep"][key]
