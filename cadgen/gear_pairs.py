@@ -240,6 +240,31 @@ def _list(indices, limit=8):
     return shown + (f" and {len(indices) - limit} more" if len(indices) > limit else "")
 
 
+def angle_at_arc(curve: ArcLengthCurve, s: float) -> float:
+    """Polar angle (body frame) of the pitch-curve point at arc length ``s``."""
+    point = curve.frame(np.array([s]))[0][0]
+    return float(np.arctan2(point[1], point[0]))
+
+
+def arc_at_angle(curve: ArcLengthCurve, angle: float, samples: int = 4096) -> float:
+    """Arc length of the pitch-curve point at polar angle ``angle`` (the curve is star-shaped
+    about its centre): a dense table, then Newton's method on the polar angle."""
+    s = np.arange(samples) * (curve.length / samples)
+    points = curve.frame(s)[0]
+    polar = np.unwrap(np.arctan2(points[:, 1], points[:, 0]))
+    turn = np.sign(polar[-1] - polar[0])
+    target = polar[0] + np.mod(turn * (angle - polar[0]), 2 * np.pi) * turn
+    guess = float(np.interp(turn * target, turn * np.append(polar, polar[0] + turn * 2 * np.pi),
+                            np.append(s, curve.length)))
+    for _ in range(3):
+        point, tangent, _ = curve.frame(np.array([guess]))
+        p, t = point[0], tangent[0]
+        rate = (p[0] * t[1] - p[1] * t[0]) / (p @ p)     # d(polar angle)/ds
+        error = np.angle(np.exp(1j * (np.arctan2(p[1], p[0]) - angle)))
+        guess -= error / rate
+    return float(np.mod(guess, curve.length))
+
+
 def mating_phase(drive_curve: ArcLengthCurve, drive_phase: float, driven_curve: ArcLengthCurve,
                  pitch: float) -> float:
     """Phase of the driven gear so that it meshes with the drive at the contact of ``tau = 0``.
@@ -306,6 +331,11 @@ def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
         system = ToothSystem(module if module is not None else curves[0].length / (np.pi * teeth[0]))
     if drive_phase is None:  # a tooth centred on the start contact
         drive_phase = float(curves[0].arc_of_source(np.array([0.0]))[0])
+    elif drive_gear is not None:
+        # a gear carried from another mesh: its phase is the body angle of a tooth centre
+        # (arc lengths of two meshes start at different contacts: half a turn apart on an
+        # idler, which is half a pitch off for an odd tooth count)
+        drive_phase = arc_at_angle(curves[0], drive_phase)
     phases = (drive_phase, mating_phase(curves[0], drive_phase, curves[1], system.pitch))
     options = dict(force_shaper=force_shaper, bore_radius=bore_radius, flank_points=flank_points)
     first = drive_gear or generate_gear(pair.names[0], curves[0], teeth[0], system, phases[0],

@@ -98,8 +98,12 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
 
 
 def _carry(generated):
-    """Phase and cut gear of a pair's driven gear, to drive the next mesh."""
-    return generated.phases[1], (generated.profiles[1], generated.checks[1], generated.spaces[1])
+    """A pair's driven gear, to drive the next mesh: the body angle of one of its tooth
+    centres (arc lengths of the two meshes start at different contacts) and the cut gear."""
+    from .gear_pairs import angle_at_arc
+
+    return (angle_at_arc(generated.curves[1], generated.phases[1]),
+            (generated.profiles[1], generated.checks[1], generated.spaces[1]))
 
 
 def planting_pair(mechanism) -> PitchPair:

@@ -79,7 +79,12 @@ def planting_shells(params, mechanism) -> dict:
     """
     housing = params.housing
     module_nc = mechanism.module(params.pitch_curve.teeth)
-    module_c = circular_module(planting_circular_radii(mechanism), params.gears.circular_module)
+    try:
+        module_c = circular_module(planting_circular_radii(mechanism), params.gears.circular_module)
+    except DesignError:
+        # no whole-tooth module: the teeth stage says so; the envelopes (and the kinematic
+        # metrics) size the circular gears as if they had the non-circular gears' module
+        module_c = params.gears.circular_module or module_nc
     size = {}
     for name, module in (("gearbox1", module_c), ("gearbox2", max(module_nc, module_c))):
         size[name] = ShellSize(housing.clearance_for(module), housing.wall_for(module),

@@ -190,3 +190,21 @@ def test_sweeps_run_beside_the_teeth_give_the_same_clearances(params):
     assert "second process" in stages["arm_interference"]["message"]
     for key in ("arm_interference", "ground_clearance"):
         assert beside.report["sweep"][key] == alone.report["sweep"][key]
+
+
+def test_circular_gears_without_a_whole_tooth_module_fail_the_teeth_stage_only():
+    """R = 37 mm: no module in 0.05-mm steps gives whole teeth to 37, 44.4, 40.7 and 27 mm."""
+    params = load_params_text(edited(R="37.0"))
+    report = build(params, None, effects=["metrics", "teeth"]).report
+    stages = {s["stage"]: s for s in report["stages"]}
+    assert stages["metrics"]["status"] == "ok"
+    assert stages["teeth"]["status"] == "failed"
+    assert stages["teeth"]["problems"][0]["path"] == "gears.circular_module"
+    assert stages["teeth"]["problems"][0]["code"] == "fractional_teeth"
+    assert not report["passed"]
+
+
+def load_params_text(text):
+    from cadgen.params import validate_text
+
+    return validate_text(text)

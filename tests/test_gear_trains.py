@@ -160,3 +160,18 @@ def test_the_file_can_ask_for_a_shaper_everywhere():
     params = validate_text(text, check_feasibility=False)
     train = planting_train(params, build_mechanism(params))
     assert all("shaper" in g["cutter"] for g in train_report(train)["gears"])
+
+
+def test_an_idler_with_an_odd_tooth_count_meshes_on_both_sides():
+    """R = 35 mm: module 1, idler 2 has 77 teeth. Its two meshes start half a turn apart on it,
+    which is half a pitch for an odd count: carried as an arc length, its phase put teeth
+    into teeth (every pose interfered); carried as a body angle, both meshes run clean."""
+    from cadgen.params import validate_text
+    from helpers import edited
+
+    params = validate_text(edited(R="35.0"))
+    train = planting_train(params, build_mechanism(params))
+    report = train_report(train)
+    teeth = {g["gear"]: g["teeth"] for g in report["gears"]}
+    assert teeth["idler 2"] == 77
+    assert all(mesh["interference_poses"] == 0 for mesh in report["meshes"])

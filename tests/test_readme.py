@@ -14,7 +14,7 @@ def commands():
 
 def test_two_setup_commands():
     main, tests = commands()
-    assert main.endswith("cadgen analyze params/xin2024-planter.toml")
+    assert main.endswith("cadgen build params/xin2024-planter.toml")
     assert re.search(r"pytest", tests)
 
 
