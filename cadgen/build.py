@@ -331,7 +331,8 @@ STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "teeth": _tee
 
 # --------------------------------------------------------------------------- the build
 def build(params, output_root: Path | str | None = Path("outputs"), *, effects=None,
-          case: str | None = None, steps: int | None = None) -> BuildResult:
+          case: str | None = None, steps: int | None = None,
+          preset: str | None = None) -> BuildResult:
     """Build one validated design: the stages its effects need, then its outputs.
 
     Parameters
@@ -346,13 +347,22 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         Overrides the file's ``scene.case``.
     steps : int, optional
         Overrides ``resolution.steps_per_revolution`` (planting).
+    preset : {"draft", "standard", "fine"}, optional
+        Overrides the file's ``scene.preset``: the resolution of every knob the file
+        leaves out (see :mod:`cadgen.presets`).
     """
+    from .presets import apply_preset
+
     scene = params.scene
+    preset = preset or scene.preset
+    params, knobs = apply_preset(params, preset)
     effects = tuple(effects) if effects is not None else scene.effects
     case = case or scene.case
     stages, set_aside = plan(effects, params.mechanism, case)
     run = _Build(params, stages, steps)
     run.effects, run.case = effects, case
+    run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
+                                            for path, (value, source) in knobs.items()}}
     run.run(STAGE_FUNCTIONS)
     from .report_build import assemble_report
 

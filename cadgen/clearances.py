@@ -30,7 +30,7 @@ __all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
 
 #: Parts of one planting arm (instances carry ``-arm1`` / ``-arm2``).
 ARM_PARTS = ("gearbox2", "cam", "planter-shell", "blade-right", "blade-left")
-#: The certified minimum is within this of the true one (mm).
+#: The certified minimum is within this of the true one (mm), by default (resolution.sweep_atol).
 SWEEP_ATOL = 1e-6
 #: Screening steps per sweep: the second-order screen needs few (benchmarks/sweep.py).
 SWEEP_STEPS = 90
@@ -135,7 +135,8 @@ def arm_interference(params, mechanism, solids, cam) -> dict:
     speed, acceleration = _arm_bounds(mechanism, parts, cam)
     # arm 2 is arm 1 half a turn on, so the distance repeats every half turn
     result = certified_distance(scene, lipschitz=2 * speed, acceleration=2 * acceleration,
-                                upper=math.pi, atol=SWEEP_ATOL, steps=SWEEP_STEPS)
+                                upper=math.pi, atol=params.resolution.sweep_atol,
+                                steps=SWEEP_STEPS)
     kinematic = _arm_distance_estimate(params, mechanism)
     return _section(result, "arm distance (solids, FCL)", params.targets.arm_distance_min,
                     kinematic)
@@ -160,14 +161,15 @@ def ground_clearance(params, design, solids, field) -> dict:
         centre = (*np.asarray(link.centre, dtype=float), 0.0)
         speed = part_reach(parts["gear-case"], body_origin_local=centre, axis=_Z)
         result = certified_distance(FclScene(assembly, housings, ["ground"]), lipschitz=speed,
-                                    acceleration=speed, atol=SWEEP_ATOL, steps=SWEEP_STEPS)
+                                    acceleration=speed, atol=params.resolution.sweep_atol,
+                                    steps=SWEEP_STEPS)
         # the case must stay out of the soil (no kinematic estimate for this mechanism)
         return _section(result, "gear case ground clearance (solids, FCL)", 0.0, None)
     rc = design.carrier_radii["C"]
     housings = ["gearbox1", "gearbox2-arm1", "gearbox2-arm2"]
     speed = max(part_reach(parts["gearbox1"], axis=_Z), rc + part_reach(parts["gearbox2"], axis=_Z))
     scene = FclScene(assembly, housings, ["ground"])
-    result = certified_distance(scene, lipschitz=speed, acceleration=speed, atol=SWEEP_ATOL,
-                                steps=SWEEP_STEPS)
+    result = certified_distance(scene, lipschitz=speed, acceleration=speed,
+                                atol=params.resolution.sweep_atol, steps=SWEEP_STEPS)
     return _section(result, "gearbox ground clearance (solids, FCL)",
                     params.targets.ground_clearance_min, _kinematic(field, "ground_clearance"))

@@ -93,7 +93,8 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
     try:
         result = cadgen.build.build(params, output_root=Path(args.output_dir),
-                                    effects=args.effects, case=args.case, steps=args.steps)
+                                    effects=args.effects, case=args.case, steps=args.steps,
+                                    preset=args.preset)
     except MechanismError as exc:   # stages report their own failures; this is anything else
         print(f"{args.file}: {exc}", file=sys.stderr)
         return EXIT_PROBLEMS
@@ -112,6 +113,9 @@ def _add_build_arguments(command: argparse.ArgumentParser) -> None:
                               "scene, or all)")
     command.add_argument("--case", choices=("field", "bench"), default=None,
                          help="operating case, overriding [scene] case")
+    command.add_argument("--preset", choices=("draft", "standard", "fine"), default=None,
+                         help="accuracy preset for every resolution knob the file leaves out, "
+                              "overriding [scene] preset (default: standard)")
     command.add_argument("--steps", metavar="N", type=_steps, default=None,
                          help="steps per revolution, overriding [resolution] steps_per_revolution")
     command.set_defaults(handler=_cmd_build)

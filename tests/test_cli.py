@@ -115,9 +115,9 @@ def fake_analysis(monkeypatch):
     calls = []
     module = types.SimpleNamespace(fail=None, calls=calls)
 
-    def build(params, *, output_root, effects=None, case=None, steps=None):
+    def build(params, *, output_root, effects=None, case=None, steps=None, preset=None):
         calls.append({"params": params, "output_root": output_root, "steps": steps,
-                      "effects": effects, "case": case})
+                      "effects": effects, "case": case, "preset": preset})
         if module.fail:
             raise module.fail
         return _FakeResult()
@@ -149,6 +149,12 @@ def test_build_passes_effects_and_case(fake_analysis):
                  "--case", "bench"]) == EXIT_OK
     (call,) = fake_analysis.calls
     assert call["effects"] == ["metrics", "plots"] and call["case"] == "bench"
+    assert call["preset"] is None   # the file's scene decides
+
+
+def test_build_passes_the_preset(fake_analysis):
+    assert main(["build", str(REFERENCE), "--preset", "draft"]) == EXIT_OK
+    assert fake_analysis.calls[0]["preset"] == "draft"
 
 
 def test_build_rejects_an_unknown_effect(fake_analysis, capsys):

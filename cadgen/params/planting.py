@@ -193,6 +193,8 @@ class ResolutionParameters(_Table):
         3600, ge=STEPS_PER_REVOLUTION_RANGE[0], le=STEPS_PER_REVOLUTION_RANGE[1]
     )
     closure_rtol: float = Field(1e-13, ge=CLOSURE_RTOL_RANGE[0], le=CLOSURE_RTOL_RANGE[1])
+    sweep_atol: float = Field(1e-6, ge=1e-12, le=1.0,
+                              description="the FCL sweeps' certified minima within this, mm")
 
 
 class PlantingParameters(_Table):

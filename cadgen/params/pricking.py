@@ -238,6 +238,8 @@ class PrickingResolutionParameters(_Table):
         720, ge=INVERSE_GRID_RANGE[0], le=INVERSE_GRID_RANGE[1],
         description="uniform carrier-angle samples per turn of the inverse solve",
     )
+    sweep_atol: float = Field(1e-6, ge=1e-12, le=1.0,
+                              description="the FCL sweeps' certified minima within this, mm")
 
 
 class PrickingParameters(_Table):

@@ -35,6 +35,9 @@ class SceneParameters(_Table):
     effects: Annotated[tuple[Effect, ...], BeforeValidator(_list_to_tuple)] = Field(
         EFFECTS, min_length=1, description="effects to evaluate (default: every one)")
 
+    preset: Literal["draft", "standard", "fine"] = Field(
+        "standard", description='accuracy preset: "draft", "standard" or "fine" (see cadgen.presets)')
+
     @field_validator("effects")
     @classmethod
     def _each_once(cls, effects: tuple) -> tuple:
