@@ -17,7 +17,10 @@ against the converged centre distance, with the 1-degree rectangle rule as the
 paper's peer.
 
 Solids: the mesh resolution (segments per circle, flank points per tooth) against
-closed forms and converged references, see :mod:`benchmarks.mesh_resolution`.
+closed forms and converged references, see :mod:`benchmarks.mesh_resolution`. Teeth
+(flank points against a simulated cut), DXF chord tolerance and the sweep tolerance,
+see :mod:`benchmarks.knobs`, which also draws ``docs/accuracy.png``: error against time
+of every knob, log-log.
 
 Pricking mechanism: the inverse solve is exact along the curve (piecewise
 Chebyshev); the resolution knob is the uniform carrier grid on which the pitch
@@ -164,14 +167,17 @@ def pricking_table():
 
 
 def solids_lines():
-    """The mesh-resolution tables of the solids (see benchmarks/mesh_resolution.py)."""
+    """The mesh-resolution tables of the solids (see benchmarks/mesh_resolution.py), and their
+    rows (segments, flank points) for the plot."""
     from cadgen.design import build_mechanism
     from cadgen.params import load_params
 
-    from .mesh_resolution import markdown
+    from .mesh_resolution import flank_table, markdown, segments_table
 
     params = load_params(Path(__file__).resolve().parents[1] / "params" / "xin2024-planter.toml")
-    return markdown(params, build_mechanism(params))
+    mechanism = build_mechanism(params)
+    segments, flanks = segments_table(params, mechanism), flank_table(params, mechanism)
+    return markdown(segments, flanks), segments, flanks
 
 
 def main(argv=None):
@@ -233,8 +239,32 @@ def main(argv=None):
     for name, degree, grid, deviation, closure, seconds in pricking:
         lines.append(f"| {name} | {degree} | {grid} | {deviation:.1e} | {closure:.1e} | "
                      f"{seconds * 1e3:.0f} |")
-    lines += solids_lines()
-    lines.append("")
+    mesh_lines, segments, _ = solids_lines()
+    lines += mesh_lines
+    from .knobs import markdown as knob_markdown, plot, sweep_rows, tooth_rows
+
+    flank, dxf = tooth_rows()
+    sweeps = sweep_rows()
+    lines += knob_markdown(flank, dxf, sweeps)
+    figure = args.output.with_suffix(".png")
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    series = {
+        "metrics, refined (mm)": [(r[4], max(r[2], 1e-16)) for r in rows if r[1] == "refined"],
+        "metrics, read off samples (peer, mm)": [(r[4], r[2]) for r in rows
+                                                if r[1] != "refined"],
+        "closure, trapezoid nodes (mm)": [(row[3], row[2]) for row in closure_rows
+                                          if row[0].startswith("trapezoid")],
+        "pricking inverse grid, kernel-b quintic (mm)": [
+            (row[5], row[3]) for row in pricking if row[0] == "kernel-b" and row[1] == 5],
+        "tooth flank points (mm)": [(row["seconds"], row["deviation_flank"]) for row in flank],
+        "DXF chord tolerance (mm)": [(row["seconds"], row["deviation_max"]) for row in dxf],
+        "segments per circle (relative volume)": [(row[4] / 1e3, abs(row[1]))
+                                                  for row in segments],
+        "sweep tolerance, arms (mm)": [(row[5], row[3]) for row in sweeps
+                                       if row[0].startswith("arm")],
+    }
+    plot(series, figure)
+    lines += ["", f"![error against time, every knob]({figure.name})", ""]
     args.output.parent.mkdir(parents=True, exist_ok=True)
     args.output.write_text("\n".join(lines))
     print(f"wrote {args.output}")

@@ -131,9 +131,8 @@ def flank_table(params, mechanism):
     return rows
 
 
-def markdown(params, mechanism) -> list:
-    segments = segments_table(params, mechanism)
-    flanks = flank_table(params, mechanism)
+def markdown(segments, flanks) -> list:
+    """The tables of :func:`segments_table` and :func:`flank_table` rows."""
     lines = ["", "## Solids: mesh resolution", "",
              "Relative errors of the extruded parts (negative: the mesh is smaller). Round "
              "features are inscribed polygons (the tube) except the housings, whose outlines are "

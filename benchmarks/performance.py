@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import statistics
 import subprocess
@@ -30,8 +29,7 @@ import tempfile
 import time
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-PARAMS = REPO / "params" / "xin2024-planter.toml"
+from ._paper import PARAMS, REPO
 
 
 def _cadgen(*args, cwd=None) -> float:
@@ -56,32 +54,12 @@ def build_times(root: Path, repeat: int, effects=None) -> dict:
 
 def sweep_table() -> list:
     """``[(clearance, method, minimum, error, poses, seconds)]`` with the build's own bounds."""
-    from cadgen.build import STAGE_FUNCTIONS, _Build
-    from cadgen.clearances import ARM_PARTS, SWEEP_ATOL, SWEEP_STEPS, _arm_bounds
-    from cadgen.params import load_params
-    from cadgen.solids.sweep import FclScene, certified_distance, part_reach, plain_scan
+    from cadgen.clearances import SWEEP_ATOL, SWEEP_STEPS
+    from cadgen.solids.sweep import certified_distance, plain_scan
 
-    params = load_params(PARAMS)
-    run = _Build(params, ["kinematics", "metrics", "cam", "parts"], None)
-    run.effects, run.case = ["solids"], "field"
-    run.run(STAGE_FUNCTIONS)
-    mechanism, assembly, cam = run.values["kinematics"], run.values["parts"].assembly, \
-        run.values["cam"]
-    parts = {part.name: part for part in assembly.parts}
-    speed, acceleration = _arm_bounds(mechanism, parts, cam)
-    rc = mechanism.carrier_radii["C"]
-    z = (0.0, 0.0, 1.0)
-    ground_speed = max(part_reach(parts["gearbox1"], axis=z),
-                       rc + part_reach(parts["gearbox2"], axis=z))
-    cases = [
-        ("arm to arm (blades included)",
-         lambda: FclScene(assembly, [f"{n}-arm1" for n in ARM_PARTS],
-                          [f"{n}-arm2" for n in ARM_PARTS]),
-         2 * speed, 2 * acceleration, math.pi),
-        ("housings to ground",
-         lambda: FclScene(assembly, ["gearbox1", "gearbox2-arm1", "gearbox2-arm2"], ["ground"]),
-         ground_speed, ground_speed, 2 * math.pi),
-    ]
+    from ._paper import sweep_cases
+
+    cases = sweep_cases()
     rows = []
     for label, scene_of, lipschitz, accel, upper in cases:
         reference = certified_distance(scene_of(), lipschitz=lipschitz, acceleration=accel,

@@ -1,0 +1,39 @@
+"""The paper's planting design built up to its solids, and its two sweep scenes (shared by the
+benchmarks that time the sweeps)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+PARAMS = REPO / "params" / "xin2024-planter.toml"
+_Z = (0.0, 0.0, 1.0)
+
+
+def sweep_cases():
+    """``[(label, scene factory, lipschitz, acceleration, upper)]`` with the build's own bounds."""
+    from cadgen.build import STAGE_FUNCTIONS, _Build
+    from cadgen.clearances import ARM_PARTS, _arm_bounds
+    from cadgen.params import load_params
+    from cadgen.solids.sweep import FclScene, part_reach
+
+    params = load_params(PARAMS)
+    run = _Build(params, ["kinematics", "metrics", "cam", "parts"], None)
+    run.effects, run.case = ["solids"], "field"
+    run.run(STAGE_FUNCTIONS)
+    mechanism, assembly = run.values["kinematics"], run.values["parts"].assembly
+    parts = {part.name: part for part in assembly.parts}
+    speed, acceleration = _arm_bounds(mechanism, parts, run.values["cam"])
+    rc = mechanism.carrier_radii["C"]
+    ground_speed = max(part_reach(parts["gearbox1"], axis=_Z),
+                       rc + part_reach(parts["gearbox2"], axis=_Z))
+    return [
+        ("arm to arm (blades included)",
+         lambda: FclScene(assembly, [f"{n}-arm1" for n in ARM_PARTS],
+                          [f"{n}-arm2" for n in ARM_PARTS]),
+         2 * speed, 2 * acceleration, math.pi),
+        ("housings to ground",
+         lambda: FclScene(assembly, ["gearbox1", "gearbox2-arm1", "gearbox2-arm2"], ["ground"]),
+         ground_speed, ground_speed, 2 * math.pi),
+    ]

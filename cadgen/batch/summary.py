@@ -1,0 +1,258 @@
+"""The batch summary (``batch-summary.csv`` and ``.html``), the exit code, the progress line."""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+import json
+import os
+import sys
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from kinematics.errors import Problem
+
+__all__ = ["SUMMARY_CSV", "SUMMARY_HTML", "EXIT_OK", "EXIT_FAILED", "EXIT_PROBLEMS",
+           "summary_csv", "summary_html", "write_summary", "batch_exit_code", "Progress"]
+
+SUMMARY_CSV = "batch-summary.csv"
+SUMMARY_HTML = "batch-summary.html"
+
+# The same codes as cadgen.cli (not imported from it: the CLI imports this package).
+EXIT_OK = 0
+EXIT_FAILED = 1
+EXIT_PROBLEMS = 2
+
+
+def _order(summary: Mapping) -> tuple:
+    """Summary order: by name, then source; a file given twice: the built one first."""
+    failure = summary["failure"] or {}
+    return summary["name"], summary["source"], not summary["ok"], failure.get("code", "")
+
+
+
+def _status(summary: Mapping) -> str:
+    return "ok" if summary["ok"] else "failed"
+
+
+def _yes_no(value: bool | None) -> str:
+    return "" if value is None else ("yes" if value else "no")
+
+
+def _cell(value: Any) -> str:
+    """A CSV cell: floats round-trip exactly (repr), tables and arrays as JSON."""
+    if value is None or isinstance(value, (str, int, float)):
+        return "" if value is None else repr(value) if isinstance(value, float) else str(value)
+    return json.dumps(value)
+
+
+def _columns(summaries: Sequence[Mapping]) -> tuple[list[str], list[str]]:
+    """Grid keys and metric ids of all designs, in first-seen order."""
+    grid_keys: dict[str, None] = {}
+    metric_ids: dict[str, None] = {}
+    for summary in summaries:
+        grid_keys.update(dict.fromkeys(summary.get("values", {})))
+        metric_ids.update(dict.fromkeys(summary["metrics"]))
+    return list(grid_keys), list(metric_ids)
+
+
+def _failure_codes(summary: Mapping) -> str:
+    failure = summary["failure"]
+    if not failure:
+        return ""
+    codes = [p["code"] for p in failure.get("problems") or ()] or [failure["code"]]
+    return ";".join(dict.fromkeys(codes))
+
+
+def _missed(summary: Mapping) -> str:
+    return ";".join(k for k, m in summary["metrics"].items() if m["passed"] is False)
+
+
+def _why_not(summary: Mapping) -> str:
+    """Why a built design did not pass: its missed targets, else its report's first note."""
+    missed, notes = _missed(summary), summary.get("notes") or ()
+    if missed or not notes:
+        return "missed " + (missed.replace(";", ", ") or "its targets")
+    return notes[0] + (f" (+{len(notes) - 1} more)" if len(notes) > 1 else "")
+
+
+def summary_csv(summaries: Sequence[Mapping]) -> str:
+    """The batch summary as CSV text: one row per design, ordered by name.
+
+    Columns: ``design``, ``status`` (ok/failed), ``passed`` (yes/no, empty without
+    targets), ``missed_targets``, one ``grid:<key>`` column per grid key, one column per
+    metric id (its value), ``notes`` (why a built design did not pass, when its report
+    says), ``failure_code``, ``failure`` (every problem), ``source``, ``output`` (the
+    folder under the output root). No timings or absolute paths: the same batch gives
+    the same file.
+    """
+    ordered = sorted(summaries, key=_order)
+    grid_keys, metric_ids = _columns(ordered)
+    stream = io.StringIO()
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow(["design", "status", "passed", "missed_targets",
+                     *(f"grid:{k}" for k in grid_keys), *metric_ids,
+                     "notes", "failure_code", "failure", "source", "output"])
+    for s in ordered:
+        metrics = s["metrics"]
+        writer.writerow([
+            s["name"], _status(s), _yes_no(s["passed"]), _missed(s),
+            *(_cell(s.get("values", {}).get(k)) for k in grid_keys),
+            *(_cell(metrics[k]["value"]) if k in metrics else "" for k in metric_ids),
+            "; ".join(s.get("notes", ())), _failure_codes(s),
+            s["failure"]["message"] if s["failure"] else "", s["source"],
+            Path(s["output_dir"]).name if s["output_dir"] else "",
+        ])
+    return stream.getvalue()
+
+
+_HTML_STYLE = """
+body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; }
+table { border-collapse: collapse; font-size: 0.9em; } th { background: #f3f3f3; }
+th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; vertical-align: top; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; } .ok { color: #176117; }
+.failed, .miss { color: #a40000; font-weight: bold; } td.reason { white-space: pre-wrap; }
+"""
+
+
+def summary_html(summaries: Sequence[Mapping], title: str = "Batch summary") -> str:
+    """The batch summary as one self-contained HTML page (a table, inline style).
+
+    Same rows and order as :func:`summary_csv`; metric headers carry their units, a
+    missed target is marked, and a failed design shows every problem.
+    """
+    esc = html.escape
+    ordered = sorted(summaries, key=_order)
+    grid_keys, metric_ids = _columns(ordered)
+    units = {k: m.get("unit") or "" for s in reversed(ordered) for k, m in s["metrics"].items()}
+    built = sum(s["ok"] for s in ordered)
+    not_passed = sum(s["ok"] and s["passed"] is False for s in ordered)
+    head = ["design", "status", "passed", *grid_keys,
+            *(f"{k} ({units[k]})" if units[k] else k for k in metric_ids), "failure or notes",
+            "source"]
+    rows = []
+    for s in ordered:
+        cells = [f"<td>{esc(s['name'])}</td>",
+                 f"<td class=\"{_status(s)}\">{_status(s)}</td>",
+                 f"<td class=\"{'miss' if s['passed'] is False else ''}\">"
+                 f"{_yes_no(s['passed'])}</td>"]
+        cells += [f"<td class=\"num\">{esc(_cell(s.get('values', {}).get(k)))}</td>"
+                  for k in grid_keys]
+        for k in metric_ids:
+            m = s["metrics"].get(k) or {"value": None}
+            target = f" title=\"target {esc(str(m['target']))}\"" if m.get("target") else ""
+            mark = " miss" if m.get("passed") is False else ""
+            value = "" if m["value"] is None else f"{m['value']:.6g}"
+            cells.append(f"<td class=\"num{mark}\"{target}>{value}</td>")
+        failure = s["failure"]
+        reason = ("\n".join(s.get("notes", ())) if not failure else
+                  "\n".join(str(Problem(**p)) for p in failure["problems"]) if failure["problems"]
+                  else f"{failure['message']} [{failure['code']}]")
+        cells += [f"<td class=\"reason\">{esc(reason)}</td>", f"<td>{esc(s['source'])}</td>"]
+        rows.append("<tr>" + "".join(cells) + "</tr>")
+    return (
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+        f"<title>{esc(title)}</title>\n<style>{_HTML_STYLE}</style>\n</head>\n<body>\n"
+        f"<h1>{esc(title)}</h1>\n<p>{len(ordered)} designs: {built} built, "
+        f"{len(ordered) - built} failed, {not_passed} built but did not pass.</p>\n"
+        "<table>\n<thead><tr>" + "".join(f"<th>{esc(h)}</th>" for h in head) + "</tr></thead>\n"
+        "<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>\n</body>\n</html>\n"
+    )
+
+
+def write_summary(summaries: Sequence[dict], output_root: str | os.PathLike) -> tuple[Path, Path]:
+    """Write ``batch-summary.csv`` and ``.html`` atomically under ``output_root``; their paths."""
+    from ..atomic import write_text_atomic
+
+    root = Path(output_root)
+    root.mkdir(parents=True, exist_ok=True)
+    return (write_text_atomic(root / SUMMARY_CSV, summary_csv(summaries)),
+            write_text_atomic(root / SUMMARY_HTML, summary_html(summaries)))
+
+
+def batch_exit_code(summaries: Iterable[Mapping], strict: bool = False) -> int:
+    """:data:`EXIT_OK` if every design built (and, when ``strict``, none missed a target:
+    a design without targets passes), else :data:`EXIT_FAILED`."""
+    for s in summaries:
+        if not s["ok"] or (strict and s["passed"] is False):
+            return EXIT_FAILED
+    return EXIT_OK
+
+
+# --------------------------------------------------------------------------- progress
+
+
+def _clock(seconds: float) -> str:
+    seconds = int(round(seconds))
+    hours, rest = divmod(seconds, 3600)
+    return (f"{hours}:" if hours else "") + f"{rest // 60:02d}:{rest % 60:02d}"
+
+
+def _reason(summary: Mapping) -> str:
+    failure = summary["failure"]
+    if not failure:
+        return ""
+    problems = failure.get("problems") or ()
+    more = f" (+{len(problems) - 1} more)" if len(problems) > 1 else ""
+    first = str(Problem(**problems[0])) if problems else f"{failure['message']} [{failure['code']}]"
+    return first + more
+
+
+class Progress:
+    """A one-line progress bar: ``[12/40] 30% ok 11, failed 1, eta 00:42``.
+
+    On a terminal the line is redrawn in place (failures printed above it); elsewhere (a
+    log, CI) it prints one line per finished design.
+
+    Parameters
+    ----------
+    total : int
+        Number of designs.
+    stream : text stream, default sys.stderr
+    tty : bool, optional
+        Force the terminal mode on or off (default: ``stream.isatty()``).
+    """
+
+    def __init__(self, total: int, stream: TextIO | None = None, tty: bool | None = None):
+        self.total = total
+        self.stream = sys.stderr if stream is None else stream
+        self.tty = bool(tty if tty is not None else getattr(self.stream, "isatty", bool)())
+        self.done = self.ok = self.failed = 0
+        self.start = time.perf_counter()
+        if self.tty:  # show the bar at once: the first design may take a while
+            self.stream.write(self.line())
+            self.stream.flush()
+
+    def line(self) -> str:
+        """The current progress line (no line break)."""
+        percent = 100 * self.done // self.total if self.total else 100
+        text = f"[{self.done}/{self.total}] {percent}% ok {self.ok}, failed {self.failed}"
+        if 0 < self.done < self.total:
+            elapsed = time.perf_counter() - self.start
+            text += f", eta {_clock(elapsed / self.done * (self.total - self.done))}"
+        return text
+
+    def update(self, summary: Mapping) -> None:
+        """Count one finished design and show it."""
+        self.done += 1
+        self.ok += bool(summary["ok"])
+        self.failed += not summary["ok"]
+        if self.tty:
+            if not summary["ok"]:
+                self.stream.write(f"\r\x1b[Kfailed {summary['name']}: {_reason(summary)}\n")
+            self.stream.write("\r\x1b[K" + self.line())
+        else:
+            verdict = "ok" if summary["ok"] else f"failed: {_reason(summary)}"
+            self.stream.write(f"[{self.done}/{self.total}] {summary['name']} {verdict} "
+                              f"({summary['seconds']:.1f} s)\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        """End the bar's line (terminal mode)."""
+        if self.tty and self.done:
+            self.stream.write("\n")
+            self.stream.flush()
+
