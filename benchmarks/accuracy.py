@@ -260,8 +260,8 @@ def main(argv=None):
         "DXF chord tolerance (mm)": [(row["seconds"], row["deviation_max"]) for row in dxf],
         "segments per circle (relative volume)": [(row[4] / 1e3, abs(row[1]))
                                                   for row in segments],
-        "sweep tolerance, arms (mm)": [(row[5], row[3]) for row in sweeps
-                                       if row[0].startswith("arm")],
+        "sweep tolerance, arms (certified gap, mm)": [(row[5], row[6]) for row in sweeps
+                                                      if row[0].startswith("arm")],
     }
     plot(series, figure)
     lines += ["", f"![error against time, every knob]({figure.name})", ""]

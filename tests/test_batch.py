@@ -1,4 +1,5 @@
-"""Batch builds (cadgen.batch): grid files, local processes and Dask, the summary."""
+"""Batch builds (cadgen.batch): grid files, local processes and Dask, the summary, and
+designs that fail, time out or kill their process."""
 
 from __future__ import annotations
 
@@ -8,6 +9,10 @@ import io
 import json
 import os
 import random
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -30,11 +35,14 @@ from cadgen.batch import (
     main_batch,
     run_batch,
     run_design,
+    run_design_isolated,
     summary_csv,
     summary_html,
     write_summary,
 )
+from cadgen.batch.isolated import _clean_staging
 from cadgen.params import validate_data
+from kinematics.errors import DesignError, Problem
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "params" / "xin2024-planter.toml"
@@ -71,6 +79,125 @@ def half_written_build(params, output_root, **kwargs):
     from cadgen.build import build
 
     return build(params, output_root=output_root, **FAST)
+
+
+FAULT_GRID = '[grid]\n"train.R" = { start = 35.0, stop = 37.0, num = 6 }\n'
+FAULTS = {"f-002": "collides", "f-003": "timeout", "f-004": "worker_died", "f-005": "worker_died"}
+
+
+def fault_build(params, output_root, *, pid_dir=None, **kwargs):
+    """Designs f-002 to f-005 fail four ways; the others build (metrics only).
+
+    f-002 raises a DesignError. The others first half write their folder; then f-003
+    starts a worker of its own (its pid in ``pid_dir``) and hangs past any timeout here,
+    f-004 exits with code 3 and f-005 kills itself with SIGKILL.
+    """
+    number = params.name.rsplit("-", 1)[1]
+    if number == "002":
+        raise DesignError([Problem("planter.L2", "collides", "the arm hits the housing")])
+    if number in ("003", "004", "005"):
+        with staged_directory(Path(output_root) / params.name) as staging:
+            (staging / "report.json").write_text("{")
+            if number == "003":
+                helper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+                (Path(pid_dir) / f"{params.name}.pid").write_text(str(helper.pid))
+                time.sleep(60)
+            elif number == "004":
+                os._exit(3)
+            os.kill(os.getpid(), signal.SIGKILL)
+    from cadgen.build import build
+
+    return build(params, output_root=output_root, **kwargs)
+
+
+def gone(pid: int, wait: float = 5.0) -> bool:
+    """Has process ``pid`` ended (a zombie left for init to reap counts)?"""
+    deadline = time.monotonic() + wait
+    while True:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        try:  # where init does not reap (a container), the killed worker stays a zombie
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:  # no /proc, or it has just been reaped
+            state = "?"
+        if state == "Z":
+            return True
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.05)
+
+
+def fault_batch(directory: Path, timeout: float, **options):
+    """The six designs of FAULT_GRID through ``run_batch`` with fault_build; f-003 has a
+    previous build's folder. ``(output root, summaries, pid folder)``."""
+    grid = write_grid(directory, FAULT_GRID, name="f")
+    out, pids = directory / "out", directory / "pids"
+    (out / "f-003").mkdir(parents=True)
+    (out / "f-003" / "report.json").write_text('{"previous": true}')
+    pids.mkdir()
+    seen = []
+    summaries = run_batch(expand_grid(grid), out, build=fault_build, timeout=timeout,
+                          build_kwargs={"pid_dir": str(pids), **FAST}, on_result=seen.append,
+                          **options)
+    assert len(seen) == 6
+    return out, summaries, pids
+
+
+@pytest.fixture(scope="module")
+def faultless(tmp_path_factory):
+    """f-001 and f-006 built by the plain build, no faults beside them: reports and rows."""
+    directory = tmp_path_factory.mktemp("faultless")
+    grid = write_grid(directory, FAULT_GRID, name="f")
+    jobs = [job for job in expand_grid(grid) if job.name not in FAULTS]
+    summaries = run_batch(jobs, directory / "out", workers=2, build_kwargs=FAST)
+    reports = {s["name"]: (directory / "out" / s["name"] / "report.json").read_text()
+               for s in summaries}
+    return reports, rows(summary_csv(summaries))
+
+
+def without_timings(report_text: str) -> dict:
+    report = json.loads(report_text)
+    for stage in report["stages"]:
+        stage.pop("seconds")
+    return report
+
+
+def check_faults(out: Path, summaries, pids: Path, timeout: float, faultless) -> None:
+    """Each fault reported as itself, the other designs' outputs as without faults, and
+    nothing else left behind."""
+    reports, faultless_rows = faultless
+    assert [s["name"] for s in summaries] == [f"f-00{k}" for k in range(1, 7)]
+    assert {s["name"]: (s["failure"] or {}).get("code") for s in summaries} == {
+        "f-001": None, "f-006": None, **FAULTS}
+    failure = {s["name"]: s["failure"] for s in summaries if s["failure"]}
+    assert failure["f-002"]["message"] == "planter.L2: the arm hits the housing [collides]"
+    assert failure["f-003"]["timeout"] == timeout
+    assert f"time limit of {timeout:g} s" in failure["f-003"]["message"]
+    assert failure["f-004"]["exit_code"] == 3
+    assert "exited with code 3" in failure["f-004"]["message"]
+    assert failure["f-005"]["exit_code"] == -signal.SIGKILL
+    assert "killed by SIGKILL" in failure["f-005"]["message"]
+    assert batch_exit_code(summaries) == EXIT_FAILED
+
+    # the timed-out design's own worker was killed with it
+    assert gone(int((pids / "f-003.pid").read_text()))
+    # no staging left over; the timed-out design's previous folder untouched
+    assert sorted(p.name for p in out.iterdir()) == ["f-001", "f-003", "f-006"]
+    assert (out / "f-003" / "report.json").read_text() == '{"previous": true}'
+    assert list((out / "f-003").iterdir()) == [out / "f-003" / "report.json"]
+    # the others: as if there had been no faults
+    for name in ("f-001", "f-006"):
+        assert without_timings((out / name / "report.json").read_text()) == without_timings(
+            reports[name])
+    table = rows(summary_csv(summaries))
+    assert {name: row["failure_code"] for name, row in table.items()} == {
+        "f-001": "", "f-006": "", **FAULTS}
+    for name in ("f-001", "f-006"):
+        assert {**table[name], "source": ""} == {**faultless_rows[name], "source": ""}
+    page = summary_html(summaries)
+    assert f"time limit of {timeout:g} s" in page and "[worker_died]" in page
 
 
 # --------------------------------------------------------------------------- grid files
@@ -216,12 +343,50 @@ def test_a_crashing_build_leaves_nothing_and_the_batch_goes_on(tmp_path):
     assert rows(summary_csv(summaries))["r-sweep-002"]["failure_code"] == "exception"
 
 
-def test_a_dead_worker_is_reported_not_raised(tmp_path):
-    jobs = file_jobs([REFERENCE])
+def test_a_dying_design_costs_only_itself(tmp_path):
+    jobs = file_jobs([REFERENCE, KERNEL_A])
+    summary = run_design_isolated(jobs[0], tmp_path, build=dying_build)
+    assert (summary["ok"], summary["failure"]["code"]) == (False, "worker_died")
+    assert summary["failure"]["exit_code"] == 3
+    assert summary["failure"]["message"] == "its process exited with code 3 before it gave a result"
+    # the default: one worker, which lives on to build the next design
     summaries = run_batch(jobs, tmp_path, workers=1, build=dying_build)
+    assert [s["failure"]["code"] for s in summaries] == ["worker_died", "worker_died"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_in_process_a_dead_worker_is_reported_not_raised(tmp_path):
+    jobs = file_jobs([REFERENCE])
+    summaries = run_batch(jobs, tmp_path, workers=1, build=dying_build, isolate=False)
     assert [(s["ok"], s["failure"]["code"]) for s in summaries] == [(False, "worker_error")]
     assert "BrokenProcessPool" in summaries[0]["failure"]["message"]
     assert list(tmp_path.iterdir()) == []
+    with pytest.raises(ValueError, match="own process"):
+        run_batch(jobs, tmp_path, timeout=5, isolate=False)
+    with pytest.raises(ValueError, match="positive"):
+        run_batch(jobs, tmp_path, timeout=0)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="process groups and SIGKILL")
+def test_faults_locally(tmp_path, faultless):
+    """A design that fails, one that times out (and its own worker), one that exits, one
+    killed: the batch finishes, reports each, and keeps the others' outputs."""
+    out, summaries, pids = fault_batch(tmp_path, timeout=2.0, workers=2)
+    check_faults(out, summaries, pids, 2.0, faultless)
+    assert summaries[2]["seconds"] < 10
+
+
+def test_staging_of_killed_builds_is_cleaned(tmp_path):
+    for name in (".a.staging-abcd_123", ".b.old-x1y2z3w4/b", ".c.old-aaaaaaaa/c",
+                 ".z.staging-abcdefgh", "a", "c", ".a.staging-short"):
+        (tmp_path / name).mkdir(parents=True)
+    (tmp_path / ".c.old-aaaaaaaa" / "c" / "old").write_text("")
+    removed = _clean_staging(tmp_path, ["a", "b", "c"])
+    assert removed == [".a.staging-abcd_123", ".b.old-x1y2z3w4", ".c.old-aaaaaaaa"]
+    # b was set aside when its build was killed: put back; c's new folder is kept
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        ".a.staging-short", ".z.staging-abcdefgh", "a", "b", "c"]
+    assert list((tmp_path / "c").iterdir()) == []
 
 
 def test_a_build_given_as_a_path(tmp_path):
@@ -259,14 +424,22 @@ def test_strict_fails_on_a_missed_target(tmp_path):
 # --------------------------------------------------------------------------- Dask
 
 
-def test_dask_cluster_gives_the_same_summary(three_files, tmp_path):
+@pytest.fixture(scope="module")
+def dask_scheduler():
+    """A local Dask cluster (two worker processes) for this module's tests; a worker that
+    dies fails its task at once (no retry on another worker)."""
+    dask = pytest.importorskip("dask")
     distributed = pytest.importorskip("dask.distributed")
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster:
+            yield cluster.scheduler_address
+
+
+def test_dask_cluster_gives_the_same_summary(three_files, dask_scheduler, tmp_path):
     _, summaries, _, text, _ = three_files
     jobs = guard_names(file_jobs([str(REFERENCE), str(KERNEL_A), str(INVALID)]))
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
-        on_dask = run_batch(jobs, tmp_path, scheduler=cluster.scheduler_address,
-                            build_kwargs=FAST)
+    on_dask = run_batch(jobs, tmp_path, scheduler=dask_scheduler, build_kwargs=FAST)
     assert summary_csv(on_dask) == text
 
     def stable(summary):
@@ -274,6 +447,24 @@ def test_dask_cluster_gives_the_same_summary(three_files, tmp_path):
 
     assert [stable(s) for s in on_dask] == [stable(s) for s in summaries]
     assert not (tmp_path / "bad-example").exists()
+
+
+@pytest.mark.skipif(os.name != "posix", reason="process groups and SIGKILL")
+def test_faults_on_dask(dask_scheduler, tmp_path, faultless):
+    """The fault scenario on Dask: each design's process is a new interpreter (a Dask
+    worker has threads); the Dask workers survive every fault, nothing is retried."""
+    out, summaries, pids = fault_batch(tmp_path, timeout=4.0, scheduler=dask_scheduler)
+    check_faults(out, summaries, pids, 4.0, faultless)
+
+
+def test_in_process_on_dask_a_dead_worker_is_reported(dask_scheduler, tmp_path):
+    """Without a process per design, a dying design takes its Dask worker: the scheduler
+    gives up on the task (KilledWorker; here at once, by default after 3 workers)."""
+    jobs = file_jobs([REFERENCE])
+    summaries = run_batch(jobs, tmp_path, scheduler=dask_scheduler, build=dying_build,
+                          isolate=False)
+    assert [(s["ok"], s["failure"]["code"]) for s in summaries] == [(False, "worker_error")]
+    assert "KilledWorker" in summaries[0]["failure"]["message"]
 
 
 # --------------------------------------------------------------------------- progress, CLI
@@ -327,8 +518,13 @@ def test_arguments():
     defaults = parse([])
     assert (defaults.workers, defaults.scheduler, defaults.strict, defaults.output_dir) == (
         None, None, False, "outputs")
-    with pytest.raises(SystemExit):
-        parse(["--workers", "0"])
+    assert (defaults.timeout, defaults.in_process) == (None, False)
+    assert parse(["--timeout", "2.5"]).timeout == 2.5
+    assert parse(["--in-process"]).in_process is True
+    for wrong in (["--workers", "0"], ["--timeout", "0"], ["--timeout", "soon"],
+                  ["--timeout", "5", "--in-process"]):
+        with pytest.raises(SystemExit):
+            parse(wrong)
 
 
 def test_no_designs_exits_2(capsys):
@@ -340,7 +536,7 @@ def test_end_to_end_with_the_default_build(tmp_path, capsys):
     """The real build (gears, cam, solids, plots) on one design, beside an invalid file."""
     out = tmp_path / "out"
     status = main_batch(parse([str(REFERENCE), str(INVALID), "--workers", "2",
-                               "--output-dir", str(out)]))
+                               "--output-dir", str(out), "--timeout", "300"]))
     captured = capsys.readouterr()
     assert status == EXIT_FAILED
     assert "2 designs in" in captured.out and "1 built, 1 failed" in captured.out

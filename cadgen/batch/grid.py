@@ -40,6 +40,7 @@ _NOT_SWEPT = ("name", "mechanism")
 _MIN_INDEX_DIGITS = 3
 
 
+# --------------------------------------------------------------------------- jobs
 
 
 @dataclass(frozen=True)
@@ -376,4 +377,3 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
             _assign(data, key, value)
         jobs.append(DesignJob(name, source, data=data, values=dict(zip(keys, combination))))
     return jobs
-

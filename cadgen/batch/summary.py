@@ -85,9 +85,11 @@ def summary_csv(summaries: Sequence[Mapping]) -> str:
     Columns: ``design``, ``status`` (ok/failed), ``passed`` (yes/no, empty without
     targets), ``missed_targets``, one ``grid:<key>`` column per grid key, one column per
     metric id (its value), ``notes`` (why a built design did not pass, when its report
-    says), ``failure_code``, ``failure`` (every problem), ``source``, ``output`` (the
-    folder under the output root). No timings or absolute paths: the same batch gives
-    the same file.
+    says), ``failure_code`` (its problems' codes; ``exception`` for an error in the
+    build, ``timeout``, ``worker_died``, ``worker_error``: see :mod:`cadgen.batch`),
+    ``failure`` (every problem; the time limit, the exit code or the signal), ``source``,
+    ``output`` (the folder under the output root). No timings or absolute paths: the same
+    batch gives the same file (a timeout's row names the limit, not the time taken).
     """
     ordered = sorted(summaries, key=_order)
     grid_keys, metric_ids = _columns(ordered)
@@ -255,4 +257,3 @@ class Progress:
         if self.tty and self.done:
             self.stream.write("\n")
             self.stream.flush()
-

@@ -16,11 +16,12 @@ A parameter file names its mechanism kind and holds one table per part of the de
 
 The schema is a set of frozen pydantic models, strict about types (a quoted ``"36"``
 is not a number, ``true`` is not a number, an integer is accepted where a float is
-asked), finite floats only, and no unknown keys. :func:`load_params` and
-:func:`validate_text` never stop at the first problem: they raise one
-:class:`ParameterError` that lists every problem found, each a
+asked), finite floats no larger than :data:`MAX_MAGNITUDE` (1e6) in magnitude, and no
+unknown keys. :func:`load_params` and :func:`validate_text` never stop at the first
+problem: they raise one :class:`ParameterError` that lists every problem found, each a
 :class:`~kinematics.errors.Problem` with a dotted field path (``train.R``,
-``field.plant_spacings.1``), a short code and a sentence naming the bad value.
+``field.plant_spacings.1``; a key that cannot be bare in TOML is quoted as TOML
+quotes it, ``planter."L 1"``), a short code and a sentence naming the bad value.
 
 Problem codes raised here:
 
@@ -31,10 +32,14 @@ file_not_found      the file does not exist
 not_readable        the path is a directory or cannot be read
 not_utf8            the file is not UTF-8 text
 toml_syntax         the text is not valid TOML (message has line and column)
+too_deep            arrays or inline tables nested hundreds of levels deep (valid TOML, but
+                    more than the reader's stack holds)
 missing             a required key or table is absent
 unknown_key         a key or table the schema does not know (with "did you mean")
 wrong_type          e.g. a string or boolean where a number is asked
-out_of_range        a number outside its allowed interval
+out_of_range        a number outside its allowed interval; an integer of more than 4300
+                    digits is reported alone, like a syntax error (at its path; a decimal
+                    one, which the TOML reader refuses, at its line and column)
 not_finite          nan or inf
 empty               an array that must not be empty
 invalid_name        the design name cannot name an output folder
@@ -66,7 +71,7 @@ are re-exported here: import them from :mod:`cadgen.params`.
 
 from __future__ import annotations
 
-from ._tables import NAME_PATTERN
+from ._tables import MAX_MAGNITUDE, NAME_PATTERN
 from .loading import (
     MECHANISM_KINDS,
     DesignParameters,
@@ -77,6 +82,7 @@ from .loading import (
 )
 from .planting import (
     CLOSURE_RTOL_RANGE,
+    MAX_TEETH,
     MIN_TEETH,
     STEPS_PER_REVOLUTION_RANGE,
     DesignTargets,
@@ -142,7 +148,9 @@ __all__ = [
     "DesignParameters",
     "MECHANISM_KINDS",
     "NAME_PATTERN",
+    "MAX_MAGNITUDE",
     "MIN_TEETH",
+    "MAX_TEETH",
     "STEPS_PER_REVOLUTION_RANGE",
     "CLOSURE_RTOL_RANGE",
     "EQUAL_PERIMETER",

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import math
 import re
 from collections.abc import Mapping
 from datetime import date, datetime, time
@@ -118,12 +119,35 @@ def _known_keys(node: Any) -> list[str]:
 # --------------------------------------------------------------------------- messages
 
 
+_INT_SHOWN_DIGITS = 30
+"""Integers longer than this are shortened in messages (see :func:`_int_text`)."""
+
+
+def _int_text(value: int) -> str:
+    """An integer for a sentence, its leading digits only when it is very long.
+
+    ``str()`` of an integer of more than ``sys.get_int_max_str_digits()`` (4300)
+    digits raises ``ValueError``, and a TOML hexadecimal integer can be that long;
+    a few hundred digits would swamp the message anyway.
+    """
+    magnitude = abs(value)
+    if magnitude < 10**_INT_SHOWN_DIGITS:
+        return str(value)
+    digits = int(math.log10(magnitude)) + 1
+    if magnitude < 10 ** (digits - 1):  # log10 rounded up across a power of ten
+        digits -= 1
+    elif magnitude >= 10**digits:
+        digits += 1
+    head = str(magnitude // 10 ** max(digits - 12, 0))  # integer division: no str limit
+    return f"{'-' if value < 0 else ''}{head}... ({digits} digits)"
+
+
 def _describe(value: Any) -> str:
     """A TOML reader's name for a value: ``the string "36"``, ``the boolean true``."""
     if isinstance(value, bool):
         return f"the boolean {str(value).lower()}"
     if isinstance(value, int):
-        return f"the integer {value}"
+        return f"the integer {_int_text(value)}"
     if isinstance(value, float):
         return f"the float {value!r}"
     if isinstance(value, str):
@@ -138,7 +162,37 @@ def _describe(value: Any) -> str:
 
 
 def _show(value: Any) -> str:
+    if isinstance(value, int) and not isinstance(value, bool):
+        return _int_text(value)  # repr() of a huge integer raises ValueError
     return json.dumps(value) if isinstance(value, str) else repr(value)
+
+
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def _key_text(key: Any) -> str:
+    """A key as TOML writes it: bare when it can be, else a quoted string.
+
+    A quoted key may hold anything (a newline, a dot, a control character); written
+    raw it would break the one-line ``path: message [code]`` report or make the
+    dotted path ambiguous.
+    """
+    text = str(key)
+    if isinstance(key, int) or _BARE_KEY.fullmatch(text):
+        return text
+    return '"' + "".join(_KEY_ESCAPES.get(char) or _escape(char) for char in text) + '"'
+
+
+_KEY_ESCAPES = {'"': '\\"', "\\": "\\\\", "\n": "\\n", "\t": "\\t", "\r": "\\r"}
+
+
+def _escape(char: str) -> str:
+    # TOML's escapes: printable characters stay, the others become \uXXXX / \UXXXXXXXX
+    # (json.dumps would write a surrogate pair for U+10000 and above, which TOML refuses).
+    if char.isprintable():
+        return char
+    code = ord(char)
+    return f"\\u{code:04X}" if code <= 0xFFFF else f"\\U{code:08X}"
 
 
 def _label(parts: list) -> str:
@@ -147,7 +201,7 @@ def _label(parts: list) -> str:
         return "the file"
     if isinstance(parts[-1], int):
         return f"{_label(parts[:-1])}[{parts[-1]}]"
-    return str(parts[-1])
+    return _key_text(parts[-1])
 
 
 def _close_keys(key: str, known: list[str], cutoff: float = 0.6) -> list[str]:
@@ -168,7 +222,7 @@ def _close_keys(key: str, known: list[str], cutoff: float = 0.6) -> list[str]:
 
 
 def _table_name(parts: list) -> str:
-    return ".".join(str(p) for p in parts) if parts else ""
+    return ".".join(_key_text(p) for p in parts) if parts else ""
 
 
 _EXPECTED = {
@@ -215,9 +269,10 @@ def _problems_from_error(error: Mapping[str, Any], root: Any) -> list[Problem]:
         what = "table" if isinstance(value, Mapping) else "key"
         table = _table_name(parts[:-1])
         where = f" in [{table}]" if table else " at the top level"
-        text = f"unknown {what} '{name}'{where}"
+        shown = name if name.startswith('"') else f"'{name}'"  # a quoted key shows its quotes
+        text = f"unknown {what} {shown}{where}"
         known = _known_keys(parent)
-        close = _close_keys(str(name), known)
+        close = _close_keys(str(parts[-1]), known)  # the key itself, not its quoted form
         if close:
             text += "; did you mean " + " or ".join(f"'{k}'" for k in close) + "?"
         elif known:
@@ -253,7 +308,8 @@ def _problems_from_error(error: Mapping[str, Any], root: Any) -> list[Problem]:
 
     if kind == "float_type" and isinstance(value, int) and not isinstance(value, bool):
         return [Problem(path, "out_of_range",
-                        f"{name} = {value} is too large to be represented as a float")]
+                        f"{name} = {_int_text(value)} is too large to be represented as a "
+                        "float")]
 
     if kind in _EXPECTED:
         text = f"{name} must be {_EXPECTED[kind]}, not {_describe(value)}"

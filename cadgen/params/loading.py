@@ -13,6 +13,7 @@ not pay for numpy and scipy. Validation never writes anything.
 from __future__ import annotations
 
 import re
+import sys
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -22,7 +23,14 @@ from pydantic import Field, TypeAdapter, ValidationError
 
 from kinematics.errors import DesignError, Problem
 
-from ._problems import _describe, _problems_from_error, _union_members
+from ._problems import (
+    _describe,
+    _int_text,
+    _label,
+    _problems_from_error,
+    _table_name,
+    _union_members,
+)
 from .planting import PlantingParameters
 from .pricking import PrickingParameters
 
@@ -68,6 +76,35 @@ def _structural(data: Mapping[str, Any]) -> tuple[Any, list[Problem]]:
         return None, problems
 
 
+def _too_long_integers(data: Mapping[str, Any]) -> list[Problem]:
+    """An ``out_of_range`` problem for every integer too long to print.
+
+    ``str()`` of an integer of more than ``sys.get_int_max_str_digits()`` (4300)
+    digits raises ``ValueError``, and pydantic-core prints the inputs it reports (a
+    discriminator tag, a literal choice): it swallows the error with an "Exception
+    ignored" traceback on stderr, or the message formatting crashes. Only a
+    hexadecimal, octal or binary TOML literal gives such an integer (the reader
+    refuses a decimal one), so the file is judged on them alone, as for a decimal one.
+    """
+    limit = sys.get_int_max_str_digits()
+    if not limit:
+        return []
+    bound = 10**limit
+    found = []
+    stack: list[tuple[list, Any]] = [([], data)]
+    while stack:  # not recursive: the data may nest deeper than the stack allows
+        parts, value = stack.pop()
+        if isinstance(value, Mapping):
+            stack += [(parts + [key], item) for key, item in reversed(value.items())]
+        elif isinstance(value, (list, tuple)):
+            stack += [(parts + [index], item) for index, item in reversed(list(enumerate(value)))]
+        elif isinstance(value, int) and not isinstance(value, bool) and abs(value) >= bound:
+            found.append(Problem(_table_name(parts), "out_of_range",
+                                 f"{_label(parts)} = {_int_text(value)} has more than {limit} "
+                                 "digits: far too large for any parameter"))
+    return found
+
+
 def _feasibility_problems(params: Any) -> list[Problem]:
     # Imported here: the kinematic checks pull in numpy/scipy, which a caller that
     # only parses (or prints --help) should not pay for.
@@ -108,6 +145,9 @@ def validate_data(
     if not isinstance(data, Mapping):
         problem = Problem("", "wrong_type", f"expected a table, not {_describe(data)}")
         raise ParameterError([problem], source)
+    problems = _too_long_integers(data)
+    if problems:
+        raise ParameterError(problems, source)
     params, problems = _structural(data)
     if not problems and check_feasibility:
         problems = _feasibility_problems(params)
@@ -127,6 +167,29 @@ def _syntax_problem(exc: tomllib.TOMLDecodeError) -> Problem:
     reason = getattr(exc, "msg", None) or (_TOML_POSITION.sub("", text) if match else text)
     where = f" at line {line}, column {column}" if line is not None else ""
     return Problem("", "toml_syntax", f"TOML syntax error{where}: {reason}")
+
+
+def _too_deep_problem() -> Problem:
+    return Problem("", "too_deep",
+                   "arrays or inline tables are nested too deeply to read (hundreds of levels); "
+                   "no parameter nests deeper than an array of [x, y] pairs")
+
+
+def _long_integer_problem(text: str, exc: ValueError) -> Problem:
+    if "digits" not in str(exc):
+        # Not the digit limit: keep the parser's words rather than lose the problem.
+        return Problem("", "toml_syntax", f"TOML syntax error: {exc}")
+    # Where the long run of digits starts, for the message (the parser does not say).
+    limit = sys.get_int_max_str_digits() or 4300
+    match = re.search(r"[0-9][0-9_]{%d,}" % limit, text)
+    where = ""
+    if match:
+        line = text.count("\n", 0, match.start()) + 1
+        column = match.start() - (text.rfind("\n", 0, match.start()) + 1) + 1
+        where = f" at line {line}, column {column}"
+    return Problem("", "out_of_range",
+                   f"an integer{where} has more than {limit} digits: far too large for any "
+                   "parameter")
 
 
 def validate_text(
@@ -158,6 +221,15 @@ def validate_text(
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError([_syntax_problem(exc)], source) from None
+    except RecursionError:
+        # tomllib parses arrays and inline tables recursively: a few hundred levels of
+        # nesting (valid TOML) exhaust the interpreter's stack. No parameter nests deeper
+        # than an array of pairs, so this is a bad file, not a crash.
+        raise ParameterError([_too_deep_problem()], source) from None
+    except ValueError as exc:
+        # tomllib lets int()'s digit limit (sys.get_int_max_str_digits(), 4300 by
+        # default) through as a bare ValueError for a decimal integer that long.
+        raise ParameterError([_long_integer_problem(text, exc)], source) from None
     return validate_data(data, source, check_feasibility=check_feasibility)
 
 

@@ -33,12 +33,17 @@ __all__ = [
     "ResolutionParameters",
     "PlantingParameters",
     "MIN_TEETH",
+    "MAX_TEETH",
     "STEPS_PER_REVOLUTION_RANGE",
     "CLOSURE_RTOL_RANGE",
     "E2_WHOLE_ABS_TOL",
 ]
 
 MIN_TEETH = 6
+# The only integer without an upper bound otherwise: the feasibility check divides a
+# float by it, and an integer beyond ~1.8e308 cannot become a float (OverflowError).
+# Far more teeth than any cuttable non-circular gear has.
+MAX_TEETH = 10_000
 STEPS_PER_REVOLUTION_RANGE = (36, 1_000_000)
 CLOSURE_RTOL_RANGE = (1e-15, 1e-6)
 # 2*e2 must be a whole number; this absorbs the rounding of a decimal such as 1.5 in TOML.
@@ -63,7 +68,8 @@ class LimaconParameters(_Table):
     f2_rad: float = Field(description="phase f2, rad")
     g1: float = Field(description="g1, mm")
     g2: float = Field(description="g2, mm")
-    teeth: int = Field(ge=MIN_TEETH, description="tooth count z of the non-circular gears")
+    teeth: int = Field(ge=MIN_TEETH, le=MAX_TEETH,
+                       description="tooth count z of the non-circular gears")
 
     @field_validator("e2")
     @classmethod
@@ -71,7 +77,10 @@ class LimaconParameters(_Table):
         # cos(e2 t) sin(e2 t) = sin(2 e2 t)/2 has period pi/e2: one gear turn (2 pi)
         # holds a whole number of periods only if 2*e2 is whole.
         twice = 2.0 * e2
-        if abs(twice - round(twice)) > E2_WHOLE_ABS_TOL:
+        # Distance of 2*e2 from the nearest whole number, through fmod (exact, finite):
+        # 2.0 * e2 overflows to inf above ~9e307 and round(inf) raises OverflowError.
+        offset = math.fmod(e2, 0.5)
+        if 2.0 * min(offset, 0.5 - offset) > E2_WHOLE_ABS_TOL:
             raise PydanticCustomError(
                 "inconsistent",
                 "e2 = {e2} makes 2*e2 = {twice} not a whole number, so the pitch curve "

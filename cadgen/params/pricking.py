@@ -69,8 +69,8 @@ def _pair_issue(value: Any, label: str) -> tuple[str, str] | None:
             try:
                 float(item)
             except OverflowError:
-                return "out_of_range", (f"{label}: its item {index} = {item} is too large to be "
-                                        "represented as a float")
+                return "out_of_range", (f"{label}: its item {index} = {_show(item)} is too "
+                                        "large to be represented as a float")
         elif not math.isfinite(item):
             return "not_finite", (f"{label} = {_show_array(value)} is not a pair of finite "
                                   f"numbers: its item {index} is {item!r}")
@@ -197,8 +197,8 @@ class GearParameters(CuttingParameters):
             number = float(value)
         except OverflowError:
             raise _problems_error([((), "out_of_range",
-                                    f"{name} = {value} is too large to be represented as a "
-                                    "float")]) from None
+                                    f"{name} = {_show(value)} is too large to be represented "
+                                    "as a float")]) from None
         if not math.isfinite(number):
             raise _problems_error([((), "not_finite",
                                     f"{name} = {_show(value)} is not a finite number")])
