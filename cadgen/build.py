@@ -208,12 +208,12 @@ _AHEAD: dict = {}
 
 def _start_sweeps_ahead(run, functions):
     import multiprocessing
-    import os
+
+    from .figures import _can_fork
 
     sweeps = [s for s in SWEEP_STAGES if s in run.stages]
-    if (not sweeps or "teeth" not in run.stages or (os.cpu_count() or 1) < 2
-            or "fork" not in multiprocessing.get_all_start_methods()
-            or any(run.status(need) != "ok" for need in ("metrics",))):
+    if not sweeps or "teeth" not in run.stages or not _can_fork() \
+            or run.status("metrics") != "ok":
         return None
     from concurrent.futures import ProcessPoolExecutor
 

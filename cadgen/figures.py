@@ -66,7 +66,10 @@ def build_figures(run, *, parallel: bool | None = None) -> dict:
 
 
 def _can_fork() -> bool:
-    return (os.cpu_count() or 1) > 1 and "fork" in multiprocessing.get_all_start_methods()
+    """A second core, the fork start method, and a process allowed children (a daemonic one,
+    such as a Dask worker's, is not)."""
+    return ((os.cpu_count() or 1) > 1 and "fork" in multiprocessing.get_all_start_methods()
+            and not multiprocessing.current_process().daemon)
 
 
 def _draw_in_two(jobs: dict) -> dict:
