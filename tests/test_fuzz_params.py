@@ -10,11 +10,15 @@ rejected file. The properties:
 2. structured mutations of the two reference files (a key deleted, renamed with a
    typo, its value replaced by one of another type, a table declared twice or copied
    under an unknown name, an unknown table added): parameters or a problem naming the
-   mutated field; two mutations in different tables are reported together; structurally
-   valid mutants also pass through the feasibility check without a traceback;
+   mutated field; two mutations in different tables are reported together; numbers
+   replaced by odd values (extremes, opposites, noise) and the structurally valid
+   mutants go on through the feasibility check without a traceback;
 3. small relative noise on the planting design's limacon coefficients and train (and on
    kernel-a's type-value points): the feasibility check answers with parameters holding
-   finite numbers or a ParameterError, never another exception or a numpy warning;
+   finite numbers or a ParameterError, never another exception or a numpy warning.
+   Known failures of the kinematic model (absurdly small numbers, a sun centre metres
+   away) are listed in KNOWN_KINEMATICS_FAILURES, skipped by the properties and pinned
+   as strict xfails;
 4. ``cadgen build`` / ``cadgen validate`` in-process on generated bad files: exit 2,
    the problems on stderr (stdout for validate) naming the field, nothing written.
 
@@ -34,7 +38,7 @@ import warnings
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 from pydantic import BaseModel
 
@@ -43,12 +47,12 @@ import cadgen.feasibility  # noqa: F401
 import cadgen.params
 from cadgen.cli import EXIT_PROBLEMS, main
 from cadgen.params import (
+    MAX_MAGNITUDE,
     MECHANISM_KINDS,
     ParameterError,
     PlantingParameters,
     PrickingParameters,
     load_params,
-    validate_data,
     validate_text,
 )
 from kinematics.errors import Problem
@@ -303,8 +307,9 @@ def _reported_at(problems, location) -> bool:
 
 
 def _reported_at_or_inside(problems, location) -> bool:
-    """A problem at ``location``, inside it, or, for an array item, at the enclosing array
-    item or array (a type-value point's coordinate is reported at the point)."""
+    """A problem at ``location`` or inside it; for an array item, anywhere in the enclosing
+    array (a point's coordinate is reported at the point, a repeated plant spacing at its
+    later copy)."""
     wanted = _keys(location)
     accepted = [wanted]
     if isinstance(location[-1], int):
@@ -498,7 +503,7 @@ def test_quoted_keys_are_quoted_in_paths_and_messages():
     assert sorted(_path_keys(p.path)[1] for p in problems) == ["L1\nx", "a.b"]
 
 
-# --------------------------------------------------------------------------- 2. structured mutations
+# -------------------------------------------------------------------------- 2. structured mutations
 
 _STRINGS = st.text(_TEXT_CHARS, max_size=20)
 _EXTREMES = st.sampled_from([math.nan, math.inf, -math.inf, -1e308, 1e308, 0, 0.0, -0.0, -1,
@@ -577,8 +582,9 @@ def _structured_mutation(draw, kind: str):
     return dumps(data), location, what
 
 
-def _check_mutant(text, location, what, *, check_feasibility=False):
-    params, error = _verdict(text, check_feasibility=check_feasibility)
+def _check_mutant(text, location, what):
+    """The structural verdict on a mutant: parameters, or a problem at the mutated field."""
+    params, error = _verdict(text, check_feasibility=False)
     if what == "declare_twice":
         # A table declared twice is a syntax error, at the second header, naming the table.
         (problem,) = _check_error(error)
@@ -602,12 +608,74 @@ def _check_mutant(text, location, what, *, check_feasibility=False):
     return params
 
 
-@pytest.mark.parametrize("kind", sorted(REFERENCES))
-def test_structured_mutations_name_the_mutated_field(kind):
-    @_fuzz_settings(150)
+# Known failures of the kinematic model: a traceback or a numpy warning instead of a
+# problem. They are in kinematics/ and cadgen/feasibility.py, outside the parameter
+# package; the properties skip exactly these values and test_known_kinematics_failures pins
+# each one (a strict xfail: it fails once the bug is fixed, and the entry goes).
+# Location -> the values that fail.
+def _tiny(below):
+    return lambda value: isinstance(value, (int, float)) and 0 < abs(value) < below
+
+
+KNOWN_KINEMATICS_FAILURES = {
+    # soil line = lowest point + depth rounds to the lowest point (below ~5e-14 mm):
+    # plant_events / soil_crossings raise ValueError (brentq's "f(a) and f(b) must have
+    # different signs"; for pricking an empty max())
+    ("field", "depth"): _tiny(1e-12),
+    # pricking _gear_report: sin(alpha)**2 underflows to 0, "divide by zero"
+    ("gears", "pressure_angle_deg"): _tiny(1e-150),
+    # pricking _gear_report: module * addendum underflows, 1 / limit overflows
+    ("gears", "module"): _tiny(1e-300),
+    ("gears", "addendum"): _tiny(1e-300),
+    # pricking: "divide by zero" / "overflow" in divide on a subnormal carrier speed
+    ("field", "carrier_speed_rpm"): _tiny(1e-300),
+    # planting duckbill linkage: "overflow encountered in divide" (kinematics/duckbill.py)
+    ("cam", "duckbill", "blade_length"): _tiny(1e-300),
+    # pricking, a sun centre some metres from the loop (e.g. [-10000, 0]): a negative
+    # ratio reaches kinematics/pricking.py _power_ratio, "invalid value encountered in
+    # power" (a NaN), before the verdict not_converged / no_assembly_mode
+    ("trajectory", "sun_centre"): lambda centre: isinstance(centre, list) and any(
+        isinstance(x, (int, float)) and abs(x) > 5000 for x in centre),
+}
+
+
+def _known_kinematics_failure(data: dict) -> bool:
+    for location, fails in KNOWN_KINEMATICS_FAILURES.items():
+        try:
+            value = _get(data, location)
+        except (KeyError, IndexError, TypeError):
+            continue
+        if not isinstance(value, bool) and fails(value):
+            return True
+    return False
+
+
+def _feasibility_verdict(text: str, data: dict):
+    """The verdict with the feasibility check, on a structurally valid file."""
+    assume(not _known_kinematics_failure(data))
+    params, error = _verdict(text, check_feasibility=True)
+    event("feasible" if error is None else "design problems")
+    if error is not None:
+        # design problems carry the kinematic model's own codes (snake_case all the same)
+        for problem in _check_error(error, codes=None):
+            # ... and name a table of the file (or the file)
+            assert problem.path == "" or _path_keys(problem.path)[0] in data, problem
+    return params
+
+
+@pytest.mark.parametrize(("kind", "examples"), [("planting", 300), ("pricking", 300)],
+                         ids=["planting", "pricking"])
+def test_structured_mutations_name_the_mutated_field(kind, examples):
+    @_fuzz_settings(examples)
     @given(_structured_mutation(kind))
     def check(mutant):
-        _check_mutant(*mutant)
+        text, location, what = mutant
+        params = _check_mutant(text, location, what)
+        event(what + (": valid" if params is not None else ": problems"))
+        if params is not None and kind == "planting":
+            # The structurally valid mutants go on through the kinematic checks (the
+            # pricking ones cost 0.5 s each: see the number mutations below).
+            _feasibility_verdict(text, tomllib.loads(text))
 
     check()
 
@@ -652,7 +720,7 @@ REQUIRED = {"planting": _required_keys(PlantingParameters),
 
 @pytest.mark.parametrize("kind", sorted(REFERENCES))
 def test_problems_in_two_tables_are_reported_together(kind):
-    @_fuzz_settings(60)
+    @_fuzz_settings(100)
     @given(_two_mutations(kind))
     def check(mutant):
         text, locations = mutant
@@ -665,10 +733,12 @@ def test_problems_in_two_tables_are_reported_together(kind):
     check()
 
 
-# Numbers a designer (or a fuzzer) may type into a structurally valid file.
+# Numbers a designer (or a fuzzer) may type: extremes, and anything within the magnitude
+# bound (cadgen.params.MAX_MAGNITUDE), small ones included.
 _ODD_NUMBERS = st.one_of(
-    _EXTREMES.filter(lambda v: not (isinstance(v, float) and not math.isfinite(v))),
-    st.floats(-1e6, 1e6),
+    _EXTREMES,
+    st.floats(-MAX_MAGNITUDE, MAX_MAGNITUDE),
+    st.floats(-1e-6, 1e-6),
     st.floats(allow_nan=False, allow_infinity=False),
     st.integers(-(10**6), 10**6),
 )
@@ -676,28 +746,66 @@ _ODD_NUMBERS = st.one_of(
 
 @st.composite
 def _number_mutation(draw, kind: str):
-    """A reference file with one to three numbers replaced (relative noise or odd values)."""
+    """``(text, data)``: a reference file with one to three numbers replaced by odd values,
+    their opposites, positive numbers or the same with up to 50% relative noise."""
     data = copy.deepcopy(DATA[kind])
     locations = draw(st.lists(st.sampled_from(NUMBER_LOCATIONS[kind]), min_size=1, max_size=3,
                               unique=True))
     for location in locations:
         original = _get(data, location)
-        value = draw(st.one_of(
-            _ODD_NUMBERS, st.just(-original),
-            st.floats(-0.2, 0.2).map(lambda noise, o=original: o * (1 + noise))))
-        if isinstance(original, int) and isinstance(value, float) and draw(st.booleans()):
-            value = round(value) if math.isfinite(value) and abs(value) < 1e300 else value
+        noisy = st.floats(-0.5, 0.5).map(lambda noise, o=original: o * (1 + noise))
+        # noise twice and positive numbers: most fields want a positive number, and the
+        # mutants that pass the structure are the ones the kinematic checks see
+        value = draw(st.one_of(noisy, noisy, st.floats(0.0, MAX_MAGNITUDE), _ODD_NUMBERS,
+                               st.just(-original)))
+        if isinstance(original, int) and isinstance(value, float) and math.isfinite(value) \
+                and draw(st.booleans()):
+            value = round(value)  # an integer field given an integer
         _get(data, location[:-1])[location[-1]] = value
-    return dumps(data), locations
+    return dumps(data), data
 
 
-@_fuzz_settings(60)
-@given(_number_mutation("planting"))
-def test_number_mutations_pass_the_feasibility_check_without_a_traceback(mutant):
-    text, locations = mutant
-    params, error = _verdict(text, check_feasibility=True)
+@pytest.mark.parametrize(("kind", "examples"), [("planting", 150), ("pricking", 15)],
+                         ids=["planting", "pricking"])
+def test_number_mutations_pass_the_feasibility_check_without_a_traceback(kind, examples):
+    # A pricking design that passes the structure costs ~0.5 s (the inverse design).
+    @_fuzz_settings(examples)
+    @given(_number_mutation(kind))
+    def check(mutant):
+        text, data = mutant
+        params, error = _verdict(text, check_feasibility=False)
+        if error is None:
+            _feasibility_verdict(text, data)
+        else:
+            event("structural problems")
+            _check_error(error)
+
+    check()
+
+
+@pytest.mark.parametrize(
+    ("kind", "location", "value"),
+    [
+        ("planting", ("field", "depth"), 1e-20),
+        ("pricking", ("field", "depth"), 1e-20),
+        ("pricking", ("gears", "pressure_angle_deg"), 1e-200),
+        ("pricking", ("gears", "module"), 5e-324),
+        ("pricking", ("gears", "addendum"), 5e-324),
+        ("pricking", ("field", "carrier_speed_rpm"), 5e-324),
+        ("planting", ("cam", "duckbill", "blade_length"), 5e-324),
+        ("pricking", ("trajectory", "sun_centre"), [-10000.0, 0.0]),
+    ],
+    ids=lambda v: ".".join(v) if isinstance(v, tuple) else str(v).replace(" ", ""),
+)
+@pytest.mark.xfail(strict=True, raises=(ValueError, RuntimeWarning),
+                   reason="kinematic model (KNOWN_KINEMATICS_FAILURES)")
+def test_known_kinematics_failures(kind, location, value):
+    assert KNOWN_KINEMATICS_FAILURES[location](value)
+    data = copy.deepcopy(DATA[kind])
+    data.setdefault(location[0], {})
+    _get(data, location[:-1])[location[-1]] = value
+    params, error = _verdict(dumps(data), check_feasibility=True)
     if error is not None:
-        # design problems carry the kinematic model's own codes
         _check_error(error, codes=None)
 
 
@@ -711,16 +819,13 @@ TRAIN = ("i12", "i13", "R", "r", "n")
 @given(limacon=st.tuples(*[st.floats(-0.03, 0.03)] * len(LIMACON)),
        train=st.tuples(*[st.floats(-0.03, 0.03)] * len(TRAIN)))
 def test_perturbed_planting_design_is_feasible_or_rejected_cleanly(limacon, train):
+    # ~40 ms each: the closure of the pitch curve, the tip path, the duckbill and the cam
     data = copy.deepcopy(DATA["planting"])
     for key, noise in zip(LIMACON, limacon):
         data["pitch_curve"][key] *= 1 + noise
     for key, noise in zip(TRAIN, train):
         data["train"][key] *= 1 + noise
-    params, error = _verdict(dumps(data), check_feasibility=True)
-    if error is not None:
-        for problem in _check_error(error, codes=None):
-            # a design problem names a table of the file (or the file)
-            assert problem.path == "" or _path_keys(problem.path)[0] in data, problem
+    _feasibility_verdict(dumps(data), data)
 
 
 @_fuzz_settings(6)
@@ -733,10 +838,7 @@ def test_perturbed_pricking_design_is_feasible_or_rejected_cleanly(noise):
         [x * (1 + dx), y * (1 + dy)]
         for (x, y), (dx, dy) in zip(data["trajectory"]["points"], noise)
     ]
-    params, error = _verdict(dumps(data), check_feasibility=True)
-    if error is not None:
-        for problem in _check_error(error, codes=None):
-            assert problem.path == "" or _path_keys(problem.path)[0] in data, problem
+    _feasibility_verdict(dumps(data), data)
 
 
 # --------------------------------------------------------------------------- 4. the command line
