@@ -373,8 +373,24 @@ class GearStage:
         return self.drive.perimeter
 
 
+def _positive(i):
+    """``i`` unchanged, or ``ratio_not_positive``: a power of a negative ratio would be NaN.
+
+    The extreme search checks the ratio first; this guards a dip it could not see (a loop
+    far from the sun centre), wherever the ratio is raised to a power.
+    """
+    if np.any(np.asarray(i) <= 0.0):
+        raise DesignError.single(
+            "trajectory.points", "ratio_not_positive",
+            f"the planet's ratio to the carrier i = 1 - dphi2/dphi1 falls to "
+            f"{float(np.min(i)):.4g}: the needle would have to turn back faster than the carrier; "
+            "move the sun centre nearer the loop or spread the points of the pricking segment")
+    return i
+
+
 def _power_ratio(i, di, ddi, constant, exponent):
     """``g = C i^e`` and its first two derivatives along the curve parameter."""
+    i = _positive(i)
     g = constant * i**exponent
     dg = constant * exponent * i ** (exponent - 1) * di
     ddg = constant * exponent * ((exponent - 1) * i ** (exponent - 2) * di**2
@@ -407,7 +423,7 @@ class _StageGeometry:
         """``integral i^w dphi1`` over one turn (magnitude)."""
         sense = self.motion.sense
         return PiecewiseChebyshev.interpolate(
-            lambda v: self.ratio(v) ** exponent * sense * self.turn_rate(v),
+            lambda v: _positive(self.ratio(v)) ** exponent * sense * self.turn_rate(v),
             self.ratio.breaks).integral()
 
     def gear_curve(self, v, constant, exponent, role, angle_factor):

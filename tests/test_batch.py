@@ -552,3 +552,14 @@ def test_end_to_end_with_the_default_build(tmp_path, capsys):
     assert list(folder.glob("plots/*.png"))
     assert not (out / "bad-example").exists()
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_a_grid_file_nested_too_deep_is_a_problem_not_a_crash(tmp_path):
+    """The grid reader shares the parameter files' TOML reader (fuzzing found the crash)."""
+    from cadgen.batch import GridError, expand_grid
+
+    grid = tmp_path / "deep.toml"
+    grid.write_text('base = "x.toml"\n[grid]\n"train.R" = ' + "[" * 2000 + "]" * 2000 + "\n")
+    with pytest.raises(GridError) as caught:
+        expand_grid(grid)
+    assert {p.code for p in caught.value.problems} == {"too_deep"}

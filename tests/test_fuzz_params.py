@@ -17,8 +17,8 @@ rejected file. The properties:
    kernel-a's type-value points): the feasibility check answers with parameters holding
    finite numbers or a ParameterError, never another exception or a numpy warning.
    Known failures of the kinematic model (absurdly small numbers, a sun centre metres
-   away) are listed in KNOWN_KINEMATICS_FAILURES, skipped by the properties and pinned
-   as strict xfails;
+   away) were fixed in the model (engineering minimums in the schema, a guard on the
+   ratio) and are pinned by test_former_kinematics_failures_are_specific_errors;
 4. ``cadgen build`` / ``cadgen validate`` in-process on generated bad files: exit 2,
    the problems on stderr (stdout for validate) naming the field, nothing written.
 
@@ -611,32 +611,15 @@ def _check_mutant(text, location, what):
 # Known failures of the kinematic model: a traceback or a numpy warning instead of a
 # problem. They are in kinematics/ and cadgen/feasibility.py, outside the parameter
 # package; the properties skip exactly these values and test_known_kinematics_failures pins
-# each one (a strict xfail: it fails once the bug is fixed, and the entry goes).
+# each one (none are left; a new one goes here until it is fixed).
 # Location -> the values that fail.
 def _tiny(below):
     return lambda value: isinstance(value, (int, float)) and 0 < abs(value) < below
 
 
-KNOWN_KINEMATICS_FAILURES = {
-    # soil line = lowest point + depth rounds to the lowest point (below ~5e-14 mm):
-    # plant_events / soil_crossings raise ValueError (brentq's "f(a) and f(b) must have
-    # different signs"; for pricking an empty max())
-    ("field", "depth"): _tiny(1e-12),
-    # pricking _gear_report: sin(alpha)**2 underflows to 0, "divide by zero"
-    ("gears", "pressure_angle_deg"): _tiny(1e-150),
-    # pricking _gear_report: module * addendum underflows, 1 / limit overflows
-    ("gears", "module"): _tiny(1e-300),
-    ("gears", "addendum"): _tiny(1e-300),
-    # pricking: "divide by zero" / "overflow" in divide on a subnormal carrier speed
-    ("field", "carrier_speed_rpm"): _tiny(1e-300),
-    # planting duckbill linkage: "overflow encountered in divide" (kinematics/duckbill.py)
-    ("cam", "duckbill", "blade_length"): _tiny(1e-300),
-    # pricking, a sun centre some metres from the loop (e.g. [-10000, 0]): a negative
-    # ratio reaches kinematics/pricking.py _power_ratio, "invalid value encountered in
-    # power" (a NaN), before the verdict not_converged / no_assembly_mode
-    ("trajectory", "sun_centre"): lambda centre: isinstance(centre, list) and any(
-        isinstance(x, (int, float)) and abs(x) > 5000 for x in centre),
-}
+KNOWN_KINEMATICS_FAILURES: dict = {}
+"""Location -> values the kinematic model still fails on (none left: see
+test_former_kinematics_failures_are_specific_errors, which pins the ones fuzzing found)."""
 
 
 def _known_kinematics_failure(data: dict) -> bool:
@@ -784,29 +767,36 @@ def test_number_mutations_pass_the_feasibility_check_without_a_traceback(kind, e
 
 
 @pytest.mark.parametrize(
-    ("kind", "location", "value"),
+    ("kind", "location", "value", "code"),
     [
-        ("planting", ("field", "depth"), 1e-20),
-        ("pricking", ("field", "depth"), 1e-20),
-        ("pricking", ("gears", "pressure_angle_deg"), 1e-200),
-        ("pricking", ("gears", "module"), 5e-324),
-        ("pricking", ("gears", "addendum"), 5e-324),
-        ("pricking", ("field", "carrier_speed_rpm"), 5e-324),
-        ("planting", ("cam", "duckbill", "blade_length"), 5e-324),
-        ("pricking", ("trajectory", "sun_centre"), [-10000.0, 0.0]),
+        # the soil line rounded onto the lowest point (brentq had no bracket)
+        ("planting", ("field", "depth"), 1e-20, "out_of_range"),
+        ("pricking", ("field", "depth"), 1e-20, "out_of_range"),
+        # sin(alpha)**2 underflowed to 0 in the undercut limit
+        ("pricking", ("gears", "pressure_angle_deg"), 1e-200, "out_of_range"),
+        # module * addendum underflowed, 1 / limit overflowed
+        ("pricking", ("gears", "module"), 5e-324, "out_of_range"),
+        ("pricking", ("gears", "addendum"), 5e-324, "out_of_range"),
+        # divide by zero on a subnormal carrier speed
+        ("pricking", ("field", "carrier_speed_rpm"), 5e-324, "out_of_range"),
+        # overflow in the duckbill linkage
+        ("planting", ("cam", "duckbill", "blade_length"), 5e-324, "out_of_range"),
+        # a sun centre 10 m away: the ratio dips below zero where the extreme search does
+        # not look, and a power of it was a NaN before the verdict
+        ("pricking", ("trajectory", "sun_centre"), [-10000.0, 0.0], "ratio_not_positive"),
     ],
     ids=lambda v: ".".join(v) if isinstance(v, tuple) else str(v).replace(" ", ""),
 )
-@pytest.mark.xfail(strict=True, raises=(ValueError, RuntimeWarning),
-                   reason="kinematic model (KNOWN_KINEMATICS_FAILURES)")
-def test_known_kinematics_failures(kind, location, value):
-    assert KNOWN_KINEMATICS_FAILURES[location](value)
+def test_former_kinematics_failures_are_specific_errors(kind, location, value, code):
+    """What fuzzing found in the kinematic model: a traceback or a numpy warning once, now
+    a problem with its code (engineering minimums in the schema, a guard on the ratio)."""
     data = copy.deepcopy(DATA[kind])
     data.setdefault(location[0], {})
     _get(data, location[:-1])[location[-1]] = value
     params, error = _verdict(dumps(data), check_feasibility=True)
-    if error is not None:
-        _check_error(error, codes=None)
+    assert params is None and code in {p.code for p in error.problems}, error
+    if code == "out_of_range":
+        assert ".".join(location) in {p.path for p in error.problems}
 
 
 # --------------------------------------------------------------------------- 3. perturbed designs

@@ -22,7 +22,6 @@ import json
 import math
 import os
 import re
-import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -148,10 +147,12 @@ def _read_toml(path: Path, where: str) -> tuple[dict | None, list[Problem]]:
         return None, [Problem(where, "not_utf8", f"{path} is not UTF-8 text")]
     except OSError as exc:
         return None, [Problem(where, "not_readable", f"cannot read {path}: {exc.strerror}")]
+    from cadgen.params.loading import ParameterError, parse_toml
+
     try:
-        return tomllib.loads(text), []
-    except tomllib.TOMLDecodeError as exc:
-        return None, [Problem(where, "toml_syntax", f"TOML syntax error in {path}: {exc}")]
+        return parse_toml(text), []
+    except ParameterError as error:   # syntax, nesting too deep, an integer too long
+        return None, [Problem(where, p.code, f"{path}: {p.message}") for p in error.problems]
 
 
 def _show(value: Any) -> str:

@@ -23,7 +23,7 @@ MotionLaw = Literal["cycloidal", "polynomial-345"]
 class DuckbillParameters(_Table):
     """The blades and their drive (vector loop O1-J-P2)."""
 
-    blade_length: float = Field(85.0, gt=0, description="blade hinge O1 to its tip, mm")
+    blade_length: float = Field(85.0, ge=1.0, description="blade hinge O1 to its tip, mm")
     closed_half_angle_deg: float = Field(18.0, gt=0, lt=60,
                                          description="half-angle of the closed duckbill, deg")
     blade_crank: float = Field(20.0, gt=0, description="blade crank O1-J, mm")

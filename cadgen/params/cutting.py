@@ -18,8 +18,9 @@ class CuttingParameters(_Table):
     cutter: Literal["auto", "shaper"] = Field(
         "auto", description='"auto": rack on convex stretches, pinion cutter on concave ones; '
                             '"shaper": a pinion cutter everywhere')
-    pressure_angle_deg: float = Field(20.0, gt=0, lt=45, description="pressure angle, deg")
-    addendum: float = Field(1.0, gt=0, le=2, description="addendum coefficient ha*, dimensionless")
+    pressure_angle_deg: float = Field(20.0, ge=5, lt=45, description="pressure angle, deg")
+    addendum: float = Field(1.0, ge=0.1, le=2,
+                            description="addendum coefficient ha*, dimensionless")
     dedendum: float = Field(1.25, gt=0, le=2.5, description="dedendum coefficient hf*, dimensionless")
     tip_radius: float = Field(0.38, ge=0, le=0.6,
                               description="cutter tip radius (root fillet), coefficient of the module")

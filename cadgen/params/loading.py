@@ -41,6 +41,7 @@ __all__ = [
     "load_params",
     "validate_text",
     "validate_data",
+    "parse_toml",
 ]
 
 
@@ -217,8 +218,16 @@ def validate_text(
         Listing every problem; a TOML syntax error is a single ``toml_syntax``
         problem with its line and column.
     """
+    return validate_data(parse_toml(text, source), source, check_feasibility=check_feasibility)
+
+
+def parse_toml(text: str, source: str | None = None) -> dict:
+    """TOML text as a dictionary, or a :class:`ParameterError` with one problem (never a crash).
+
+    Used for parameter files and batch grid files alike.
+    """
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError([_syntax_problem(exc)], source) from None
     except RecursionError:
@@ -230,7 +239,6 @@ def validate_text(
         # tomllib lets int()'s digit limit (sys.get_int_max_str_digits(), 4300 by
         # default) through as a bare ValueError for a decimal integer that long.
         raise ParameterError([_long_integer_problem(text, exc)], source) from None
-    return validate_data(data, source, check_feasibility=check_feasibility)
 
 
 def load_params(

@@ -129,11 +129,11 @@ class PlanterParameters(_Table):
 class FieldParameters(_Table):
     """Operating case: planting depth, plant spacings, carrier speed."""
 
-    depth: float = Field(gt=0, description="planting depth b, mm")
+    depth: float = Field(ge=0.1, description="planting depth b, mm")
     plant_spacings: Annotated[
         tuple[Annotated[float, Field(gt=0)], ...], BeforeValidator(_list_to_tuple)
     ] = Field(min_length=1, description="plant spacings S, mm")
-    carrier_speed_rpm: float = Field(30.0, gt=0, description="carrier-1 speed, r/min")
+    carrier_speed_rpm: float = Field(30.0, ge=0.01, description="carrier-1 speed, r/min")
 
     @field_validator("plant_spacings")
     @classmethod

@@ -166,7 +166,7 @@ class GearParameters(CuttingParameters):
         EQUAL_PERIMETER,
         description='w in i1 = K i^w: "equal-perimeter" or a number in [0, 4]',
     )
-    module: float = Field(2.0, gt=0, description="target module m, mm")
+    module: float = Field(2.0, ge=0.1, description="target module m, mm")
     min_ratio: float = Field(
         0.05, gt=0, description="lower bound of the total relative ratio i, dimensionless"
     )
@@ -212,9 +212,9 @@ class GearParameters(CuttingParameters):
 class PrickingFieldParameters(_Table):
     """Operating case: speeds, vertical pricking depth, inclinations of the mechanism plane."""
 
-    carrier_speed_rpm: float = Field(75.0, gt=0, description="carrier speed omega, r/min")
+    carrier_speed_rpm: float = Field(75.0, ge=0.01, description="carrier speed omega, r/min")
     forward_speed: float = Field(gt=0, description="machine speed v, mm/s")
-    depth: float = Field(gt=0, description="vertical pricking depth, mm")
+    depth: float = Field(ge=0.1, description="vertical pricking depth, mm")
     inclinations_deg: Annotated[
         tuple[Annotated[float, Field(ge=0, lt=INCLINATION_MAX_DEG)], ...],
         BeforeValidator(_list_to_tuple),
