@@ -190,20 +190,15 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments):
             discs1.append((x, y, radius["gearbox1", axis] - box1.allowance))
     housing2 = closed_shell(discs2, height=layout.box2_height, clearance=box2.clearance,
                             wall=box2.wall, segments=segments, path="housing",
-                            z_cavity_bottom=layout.box2_floor, min_wall=_min_wall())
+                            z_cavity_bottom=layout.box2_floor)
     housing1 = closed_shell(discs1, height=layout.box1_height, clearance=box1.clearance,
                             wall=box1.wall, segments=segments, path="housing",
-                            z_cavity_bottom=layout.box1_floor, min_wall=_min_wall())
+                            z_cavity_bottom=layout.box1_floor)
     return (Part("gearbox1", "housing", "carrier1", housing1.solid),
             Part("gearbox2", "housing", "gearbox2", housing2.solid,
                  instances=(("gearbox2-arm1", "gearbox2", 0.0),
                             ("gearbox2-arm2", "gearbox2", math.pi)))), (housing1, housing2)
 
-
-def _min_wall():
-    from ..params.solids import MIN_WALL
-
-    return MIN_WALL
 
 
 def _cam_part(params, mechanism, cam_design, layout, segments):

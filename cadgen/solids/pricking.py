@@ -130,7 +130,7 @@ def pricking_assembly(params, design, train, field):
     circles = [(*(centre + d * line), r) for d, r in sorted(discs.items())]
     height = faces[0] + faces[1] + 3 * gap
     case = closed_shell(circles, height=height, clearance=clearance, wall=wall, segments=segments,
-                        path="housing", z_cavity_bottom=0.0, min_wall=_min_wall())
+                        path="housing", z_cavity_bottom=0.0)
     parts.insert(0, Part("gear-case", "housing", "case", case.solid))
     parts += _rocker_and_needle(params, link, needle, z0=height + wall + gap, segments=segments)
     surface = field[0].surface_level
@@ -148,11 +148,6 @@ def pricking_assembly(params, design, train, field):
     parts.append(ground)
     return Assembly(parts, body_pose), {"gear-case": case}
 
-
-def _min_wall():
-    from ..params.solids import MIN_WALL
-
-    return MIN_WALL
 
 
 def _rocker_and_needle(params, link, needle, *, z0, segments):

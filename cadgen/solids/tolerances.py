@@ -32,9 +32,9 @@ CROSS_SECTION_AREA_RTOL = 1e-6
 #: Volume (mm^3) of a part outside a housing's cavity below which the part counts
 #: as enclosed: coplanar contact leaves zero-volume debris, not a real collision.
 ENCLOSURE_VOLUME_ATOL = 1e-6
-#: Thinnest housing wall (mm) accepted by default: below about 1 mm printed and
-#: moulded walls neither fill nor hold a gear shaft's load.
-MIN_WALL = 1.0
+#: Thinnest housing wall (mm) accepted by default: the parameter files' rule
+#: (``housing.wall``, ``wall_too_thin``), one value for both.
+from cadgen.params.solids import MIN_WALL  # noqa: E402
 #: Default largest distance (mm) between a polygon and the circle it stands for,
 #: used by :func:`cadgen.solids.outline.segments_for`.
 CHORD_TOLERANCE = 0.01
