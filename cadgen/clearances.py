@@ -12,7 +12,8 @@ angle (see that module for the formula ``v + w * reach + u``):
 * a blade also turns on its hinge by the cam's law. Its rate and acceleration
   there are the largest over 20,000 samples of the revolution plus 25 % (the law
   is smooth: cycloidal or 3-4-5), times its reach from the hinge, with the
-  Coriolis term ``2 w beta'``;
+  Coriolis term ``2 w beta'``; its reach from E is at most the hinge's distance
+  from E plus that reach, however far it opens;
 * gearbox 1 turns about O at rate 1; the ground is fixed.
 
 The pair's bound is the sum of the two groups' (arm 2 moves like arm 1). The
@@ -73,29 +74,29 @@ def _arm_bounds(mechanism, parts, cam):
         reach = part_reach(parts["planter-shell"], axis=_Z)
         speed.append(mechanism.speed_bound("E") + spin * reach)
         acceleration.append(mechanism.acceleration_bound("E") + turn * reach)
-    blades = [parts[n] for n in ("blade-right", "blade-left") if n in parts]
+    blades = [name for name in ("blade-right", "blade-left") if name in parts]
     if blades:
         rate, rate_rate = _blade_rates(cam, mechanism) if cam is not None else (0.0, 0.0)
-        for blade in blades:
-            # its reach from E changes as it opens: the largest over the opening
-            reach_e = max(part_reach(blade, axis=_Z, phi=phi)
-                          for phi in np.linspace(0, 2 * np.pi, 13))
-            pivot = _hinge_point(blade)
-            reach_h = part_reach(blade, body_origin_local=(*pivot, 0.0), axis=_Z)
+        for name in blades:
+            blade = parts[name]
+            if cam is None:   # closed blades ride on the planter like its shell
+                reach_e, reach_h = part_reach(blade, axis=_Z), 0.0
+            else:
+                hinge = _hinge(cam.linkage, name)
+                reach_h = part_reach(blade, body_origin_local=(*hinge, 0.0), axis=_Z)
+                # however far it opens, no point of it is farther from E than this
+                reach_e = float(np.hypot(*hinge)) + reach_h
             speed.append(mechanism.speed_bound("E") + spin * reach_e + rate * reach_h)
             acceleration.append(mechanism.acceleration_bound("E") + turn * reach_e
                                 + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
     return max(speed), max(acceleration)
 
 
-def _hinge_point(blade) -> np.ndarray:
-    """The fixed point of a blade's turn in the planter frame (where local(phi) leaves it be)."""
-    a, b = blade.local(0.0), blade.local(np.pi + 0.3)
-    # solve (A - B) p = t_B - t_A for the point both poses map alike (fall back to the origin)
-    rotation = a[:2, :2] - b[:2, :2]
-    if abs(np.linalg.det(rotation)) < 1e-12:
-        return np.array([0.0, 0.0])
-    return np.linalg.solve(rotation, b[:2, 3] - a[:2, 3])
+def _hinge(linkage, blade: str) -> np.ndarray:
+    """A blade's hinge in the planter frame: the right one, or its mirror in the duckbill axis."""
+    if blade == "blade-right":
+        return linkage.hinge
+    return np.array([-2.0 * linkage.L1 - linkage.hinge[0], linkage.hinge[1]])
 
 
 def _section(result, label, target, kinematic) -> dict:
