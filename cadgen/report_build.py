@@ -202,13 +202,12 @@ def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
     the tooth profile from the study's measured law.
     """
     rows = []
-    accuracy = report.get("accuracy") or {}
     if params.mechanism == "planting" and "metrics" in ok:
+        error = values["metrics"].accuracy["closure_centre_distance_error_mm"]
         rows.append({"knob": "resolution.steps_per_revolution",
                      "value": params.resolution.steps_per_revolution,
                      "achieved": "extremes and minima certified (see accuracy); centre distance "
-                                 f"within {_first(accuracy, 'closure_centre_distance_error_mm'):.1e}"
-                                 " mm",
+                                 f"within {error:.1e} mm",
                      "basis": "certified search and the closure's own error estimate"})
     if "teeth" in ok:
         train = values["teeth"]
@@ -250,15 +249,3 @@ def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
                      "basis": "certificate of the sweep (speed and acceleration bounds)"})
     return rows
 
-
-def _first(mapping, *keys):
-    """The first number found under any of ``keys`` (searched one level deep), else NaN."""
-    for key in keys:
-        if isinstance(mapping.get(key), (int, float)):
-            return float(mapping[key])
-    for value in mapping.values():
-        if isinstance(value, dict):
-            for key in keys:
-                if isinstance(value.get(key), (int, float)):
-                    return float(value[key])
-    return float("nan")

@@ -77,14 +77,15 @@ def _pitch_tables(run) -> dict:
     if run.params.mechanism == "pricking":
         design = run.values["kinematics"]
         v = np.linspace(0.0, design.motion.period, CURVE_SAMPLES, endpoint=False)
-        tables = {}
-        for name, functions in design.pitch_functions.items():
-            rho, _, psi, _ = functions(v)
-            tables[name] = (psi, rho)
-        return tables
-    from .gear_trains import planting_pair
+        gears = design.pitch_functions
+    else:
+        from .gear_trains import planting_pair
 
-    pair = planting_pair(run.values["kinematics"])
-    tau = np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES, endpoint=False)
-    return {name: (functions(tau)[2], functions(tau)[0])
-            for name, functions in zip(pair.names, (pair.drive, pair.driven))}
+        pair = planting_pair(run.values["kinematics"])
+        v = np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES, endpoint=False)
+        gears = dict(zip(pair.names, (pair.drive, pair.driven)))
+    tables = {}
+    for name, functions in gears.items():   # contact functions: (rho, drho, psi, dpsi)
+        rho, _, psi, _ = functions(v)
+        tables[name] = (psi, rho)
+    return tables
