@@ -348,11 +348,16 @@ def _audited_bytes(doc, path: Path) -> bytes:
     return doc.encode(stream.getvalue())
 
 
+def _thin_outline(points: np.ndarray, tolerance: float, centre, bore_radius: float):
+    """A cutting outline thinned to ``tolerance``, still clear of its bore: (ring, tolerance used)."""
+    keep_clear = ((np.asarray(centre, dtype=float), float(bore_radius)) if bore_radius > 0
+                  else None)
+    return _thin_ring(points, tolerance, keep_clear=keep_clear)
+
+
 def _thin_gear(profile, outline: np.ndarray, pitch: np.ndarray, tolerance: float):
     """Thinned outline, its tolerance, and thinned pitch curve of a validated profile (body frame)."""
-    centre = np.asarray(profile.centre, dtype=float)
-    keep_clear = (centre, float(profile.bore_radius)) if profile.bore_radius > 0 else None
-    thin_outline, used = _thin_ring(outline, tolerance, keep_clear=keep_clear)
+    thin_outline, used = _thin_outline(outline, tolerance, profile.centre, profile.bore_radius)
     thin_pitch, _ = _thin_ring(pitch, tolerance)
     return thin_outline, used, thin_pitch
 
@@ -372,10 +377,8 @@ def thinned_outline(profile, chord_tolerance: float = 0.005) -> np.ndarray:
 def thinned_contour(points, chord_tolerance: float = 0.005, *, centre=(0.0, 0.0),
                     bore_radius: float = 0.0) -> np.ndarray:
     """A dense closed contour thinned as the DXF writers thin it (a cam's, a gear's)."""
-    tolerance = _check_tolerance(chord_tolerance)
-    centre = np.asarray(centre, dtype=float)
-    keep_clear = (centre, float(bore_radius)) if bore_radius > 0 else None
-    return _thin_ring(_closed_points(points), tolerance, keep_clear=keep_clear)[0]
+    return _thin_outline(_closed_points(points), _check_tolerance(chord_tolerance), centre,
+                         bore_radius)[0]
 
 
 
@@ -541,8 +544,7 @@ def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius:
     if problems:
         raise DxfInputError(f"cannot export {label} to DXF", problems)
     path = Path(path)
-    keep_clear = (centre, float(bore_radius)) if bore_radius > 0 else None
-    outline, used = _thin_ring(_closed_points(contour), tolerance, keep_clear=keep_clear)
+    outline, used = _thin_outline(_closed_points(contour), tolerance, centre, bore_radius)
     pitch, _ = _thin_ring(_closed_points(pitch_curve), tolerance)
     doc = _new_document()
     _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
