@@ -26,18 +26,11 @@ import time
 
 import numpy as np
 
+from .accuracy import timed
+
 SEGMENTS = (16, 32, 64, 96, 256, 1024)
 FLANK_POINTS = (12, 24, 48, 96, 192, 384)
 REFERENCE_FLANK_POINTS = 2000
-
-
-def _best(function, repeat=3):
-    best, value = np.inf, None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        value = function()
-        best = min(best, time.perf_counter() - start)
-    return value, best
 
 
 def _tube(outer, wall, length, segments):
@@ -80,8 +73,8 @@ def segments_table(params, mechanism):
              - exact_hull(box.clearance) * height)
     rows = []
     for n in SEGMENTS:
-        tube, tube_seconds = _best(lambda: _tube(outer, wall, length, n))
-        housing, seconds = _best(lambda: to_trimesh(closed_shell(
+        tube, tube_seconds = timed(lambda: _tube(outer, wall, length, n))
+        housing, seconds = timed(lambda: to_trimesh(closed_shell(
             discs, height=height, clearance=box.clearance, wall=box.wall, segments=n).solid,
             "gearbox2"))
         rows.append((n, tube.volume / tube_volume - 1, tube.area / tube_area - 1,

@@ -30,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .accuracy import timed
+
 REPO = Path(__file__).resolve().parents[1]
 PARAMS = REPO / "params" / "xin2024-planter.toml"
 ARM_PARTS = ("gearbox2", "cam", "planter-shell")
@@ -96,15 +98,6 @@ def cases(mechanism, assembly):
     return out
 
 
-def _timed(function, repeat=1):
-    best, value = math.inf, None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        value = function()
-        best = min(best, time.perf_counter() - start)
-    return value, best
-
-
 def measure(label, scene, lipschitz, acceleration, upper, build_seconds):
     """One clearance: every figure of its table rows, as a dict."""
     from cadgen.solids.sweep import certified_distance, plain_scan
@@ -113,11 +106,11 @@ def measure(label, scene, lipschitz, acceleration, upper, build_seconds):
         return certified_distance(scene, lipschitz=lipschitz, acceleration=acceleration,
                                   steps=STEPS, atol=atol, upper=upper)
 
-    reference, reference_seconds = _timed(lambda: sweep(REFERENCE_ATOL))
+    reference, reference_seconds = timed(lambda: sweep(REFERENCE_ATOL), repeat=1)
     window = reference.argument + np.linspace(-1e-3, 1e-3, 2000)   # the argument itself left out
     dense = float(scene.distances(window).min())
-    certified, certified_seconds = _timed(lambda: sweep(ATOL), repeat=3)
-    (plain, plain_argument), plain_seconds = _timed(lambda: plain_scan(scene, PLAIN_POSES))
+    certified, certified_seconds = timed(lambda: sweep(ATOL), repeat=3)
+    (plain, plain_argument), plain_seconds = timed(lambda: plain_scan(scene, PLAIN_POSES), repeat=1)
     print(f"{label}: reference {reference.minimum:.12f} mm (bound {reference.bound:.12f}, "
           f"{reference.evaluations} poses, {reference_seconds:.2f} s); dense window "
           f"{dense:.12f}; certified {certified.minimum:.12f} ({certified.evaluations} poses, "
