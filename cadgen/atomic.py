@@ -3,7 +3,8 @@
 A file is written to a temporary sibling, flushed to disk, then renamed over the
 target (``os.replace`` is atomic on POSIX and Windows for paths on one filesystem).
 A build writes its outputs into a staged sibling directory, which replaces the
-final directory only once everything in it was written.
+final directory only once everything in it was written. :func:`check_output_root`
+says, before any work, whether a directory can take outputs at all.
 """
 
 from __future__ import annotations
@@ -15,7 +16,27 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["write_bytes_atomic", "write_text_atomic", "staged_directory"]
+from kinematics.errors import MechanismError
+
+__all__ = ["OutputDirError", "check_output_root", "write_bytes_atomic", "write_text_atomic",
+           "staged_directory"]
+
+
+class OutputDirError(MechanismError):
+    """An output directory that cannot take the outputs, with the reason.
+
+    Attributes
+    ----------
+    directory : Path
+        The directory as given.
+    reason : str
+        Why it cannot be used, for a person.
+    """
+
+    def __init__(self, directory: str | os.PathLike, reason: str):
+        self.directory = Path(directory)
+        self.reason = reason
+        super().__init__(f"output directory {self.directory}: {reason}")
 
 _DEFAULT_FILE_MODE = 0o666  # what open() would ask for, before the umask
 
@@ -47,6 +68,59 @@ def _fsync_directory(directory: Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+def check_output_root(directory: str | os.PathLike, *, name: str | None = None) -> Path:
+    """Check, before any work, that ``directory`` can take outputs; write nothing.
+
+    The directory need not exist: its nearest existing ancestor must be a directory
+    in which a folder can be made (the staged build makes the rest). Whether a
+    folder can be made is tried, not read off the permission bits, which say
+    nothing about read-only or virtual filesystems (``/proc``) or a process that
+    ignores them (root); the probe folder is removed at once.
+
+    Parameters
+    ----------
+    directory : str or path-like
+        The output root (``--output-dir``).
+    name : str, optional
+        A design's folder under it: an existing ``directory/name`` must be a directory.
+
+    Returns
+    -------
+    Path
+        ``directory`` as a Path.
+
+    Raises
+    ------
+    OutputDirError
+        Naming the directory and the reason.
+    """
+    root = Path(directory)
+    existing = root
+    while not os.path.lexists(existing) and existing.parent != existing:
+        existing = existing.parent
+    if existing != root and not existing.is_dir():
+        raise OutputDirError(root, f"{existing} is a file, not a directory, so no folder can be "
+                                   "made under it")
+    if existing == root and not root.is_dir():
+        what = "a broken link" if root.is_symlink() and not root.exists() else "a file"
+        raise OutputDirError(root, f"it exists and is {what}, not a directory")
+    try:
+        probe = tempfile.mkdtemp(dir=existing, prefix=".cadgen-probe-")
+    except OSError as error:
+        why = error.strerror or str(error)
+        raise OutputDirError(root, f"not writable: no folder can be created in it ({why})"
+                             if existing == root else
+                             f"cannot be made: no folder can be created in {existing} ({why})"
+                             ) from None
+    os.rmdir(probe)
+    if name is not None and existing == root:
+        final = root / name
+        if os.path.lexists(final) and not final.is_dir():
+            raise OutputDirError(root, f"{final} exists and is not a directory, so the design's "
+                                       "outputs cannot go there")
+    return root
 
 
 def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> Path:

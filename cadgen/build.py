@@ -20,6 +20,11 @@ ground_clearance    FCL sweep of every housing against the ground
 plots               PNG pictures of what ran
 ==================  ==========================================================
 
+A problem validation found in one stage's checks (``Problem.stage``, e.g. the
+duckbill linkage, stage ``cam``) refuses the build when the scene runs that stage
+(a :class:`~cadgen.params.ParameterError` before anything runs or is written) and is
+a warning otherwise: in the report's ``warnings`` with its stage, and in the summary.
+
 Outputs go to a staged folder that replaces ``<output_root>/<name>/`` only when
 everything was written: a failed stage leaves its outputs out and says why in
 the report, and a failure while writing leaves the previous folder untouched.
@@ -39,7 +44,8 @@ import numpy as np
 
 from kinematics.errors import ConvergenceError, DesignError, MechanismError
 
-__all__ = ["EFFECT_STAGES", "plan", "BuildResult", "build", "EXIT_OK", "EXIT_CHECKS_FAILED"]
+__all__ = ["EFFECT_STAGES", "plan", "stage_warnings", "BuildResult", "build", "EXIT_OK",
+           "EXIT_CHECKS_FAILED"]
 
 EXIT_OK = 0
 EXIT_CHECKS_FAILED = 1
@@ -141,6 +147,9 @@ class BuildResult:
         from .summary import summary_text
 
         text = summary_text(self.report)
+        for warning in self.report.get("warnings", []):
+            text += (f"\nwarning: {warning['path'] or '<file>'}: {warning['message']} "
+                     f"[{warning['code']}] (stage {warning['stage']}, not run in this build)")
         return text + (f"\nwrote {len(self.files)} files to {self.output_dir}"
                        if self.output_dir else "")
 
@@ -156,6 +165,7 @@ class _Build:
         self.records: list = []
         self.figures: dict = {}
         self.writers: list = []
+        self.warnings: list = []
 
     def status(self, stage: str) -> str:
         return next((r.status for r in self.records if r.stage == stage), "not run")
@@ -330,6 +340,23 @@ STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "teeth": _tee
 
 
 # --------------------------------------------------------------------------- the build
+def stage_warnings(params, stages) -> list:
+    """The stage problems of ``params`` whose stage is not in ``stages``, as warnings.
+
+    Raises
+    ------
+    cadgen.params.ParameterError
+        With the stage problems whose stage is in ``stages`` (the build cannot run it).
+    """
+    from .params import ParameterError, stage_problems
+
+    problems = stage_problems(params)
+    refused = [p for p in problems if p.stage in stages]
+    if refused:
+        raise ParameterError(refused)
+    return [p for p in problems if p.stage not in stages]
+
+
 def build(params, output_root: Path | str | None = Path("outputs"), *, effects=None,
           case: str | None = None, steps: int | None = None,
           preset: str | None = None) -> BuildResult:
@@ -350,8 +377,22 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     preset : {"draft", "standard", "fine"}, optional
         Overrides the file's ``scene.preset``: the resolution of every knob the file
         leaves out (see :mod:`cadgen.presets`).
+
+    Raises
+    ------
+    cadgen.atomic.OutputDirError
+        Before any stage runs, when ``output_root`` cannot take the outputs (a file, a
+        read-only or virtual filesystem, an existing ``<output_root>/<name>`` file).
+    cadgen.params.ParameterError
+        Before any stage runs, when a problem validation found belongs to a stage
+        the scene runs (see :func:`stage_warnings`); of other stages, warnings.
     """
     from .presets import apply_preset
+
+    if output_root is not None:
+        from .atomic import check_output_root
+
+        check_output_root(output_root, name=params.name)
 
     scene = params.scene
     preset = preset or scene.preset
@@ -359,7 +400,9 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     effects = tuple(effects) if effects is not None else scene.effects
     case = case or scene.case
     stages, set_aside = plan(effects, params.mechanism, case)
+    warnings = stage_warnings(params, stages)
     run = _Build(params, stages, steps)
+    run.warnings = warnings
     run.effects, run.case = effects, case
     run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
                                             for path, (value, source) in knobs.items()}}

@@ -99,7 +99,16 @@ def _hinge(linkage, blade: str) -> np.ndarray:
     return np.array([-2.0 * linkage.L1 - linkage.hinge[0], linkage.hinge[1]])
 
 
+def _verdict(result, target) -> str:
+    """``fail`` when certainly not above ``target``, ``pass`` when certainly (or within the
+    certified atol) above it, else ``undecided`` (the gap [bound, minimum] straddles it)."""
+    if result.interference_ranges or not result.minimum > target:
+        return "fail"
+    return "pass" if result.bound > target or result.certified else "undecided"
+
+
 def _section(result, label, target, kinematic) -> dict:
+    verdict = _verdict(result, target)
     return {
         "label": label, "method": "FCL mesh distance of the solids, certified minimum",
         "minimum_mm": float(result.minimum), "certified_bound_mm": float(result.bound),
@@ -112,7 +121,8 @@ def _section(result, label, target, kinematic) -> dict:
                                     for a, b in result.interference_ranges],
         "kinematic_estimate_mm": None if kinematic is None else float(kinematic),
         "target_mm": float(target),
-        "passed": bool(result.minimum > target and not result.interference_ranges),
+        "passed": verdict == "pass",
+        "verdict": verdict,
         "evaluations": int(result.evaluations),
         "lipschitz_mm_per_rad": float(result.lipschitz),
         "atol_mm": float(result.atol),

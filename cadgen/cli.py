@@ -1,23 +1,48 @@
 """Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``) and ``cadgen batch``.
 
-Exit codes: 0 success, 1 a design that was built but misses a target or fails a
-check (the report says which), 2 a parameter file or design with problems
-(nothing is written; also argparse's code for a bad command line). numpy, scipy, matplotlib and pydantic are imported
-inside the commands only, so ``cadgen --help`` starts fast.
+Exit codes (every command):
+
+- 0: success;
+- 1: a design that was built but misses a target or fails a check (the report says
+  which); ``batch``: a design failed (with ``--strict``, also one that missed a target);
+- 2: a parameter file or design with problems, or an output directory that cannot be
+  used (checked before any work; nothing is written); also argparse's code for a bad
+  command line;
+- 3 (:data:`EXIT_INTERNAL`): an unexpected exception, a bug: one line on stderr
+  (``cadgen: internal error: ...``) with the path of a file holding the traceback, the
+  versions and the command line (in ``$CADGEN_CRASH_DIR``, else the temporary directory);
+- 130 (:data:`EXIT_INTERRUPTED`): interrupted (Ctrl-C): one line, ``cadgen:
+  interrupted``; outputs are staged, so no half-written folder is left;
+- 141 (:data:`EXIT_BROKEN_PIPE`): the reader of the output went away (``| head``), quietly.
+
+Every error is one line on stderr, never a traceback. numpy, scipy, matplotlib and
+pydantic are imported inside the commands only, so ``cadgen --help`` starts fast.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_CHECKS_FAILED", "EXIT_PROBLEMS"]
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_CHECKS_FAILED", "EXIT_PROBLEMS",
+           "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE", "CRASH_DIR_VARIABLE"]
 
 EXIT_OK = 0
 EXIT_CHECKS_FAILED = 1
 EXIT_PROBLEMS = 2
+#: An unexpected exception (a bug): never 1, which means "targets missed".
+EXIT_INTERNAL = 3
+#: Interrupted by Ctrl-C (128 + SIGINT, the shell's convention).
+EXIT_INTERRUPTED = 130
+#: The reader of the output went away (128 + SIGPIPE, the shell's convention).
+EXIT_BROKEN_PIPE = 141
+#: Environment variable naming the directory of crash files (default: the temporary one).
+CRASH_DIR_VARIABLE = "CADGEN_CRASH_DIR"
+#: The longest exception message printed on the one line (the crash file has it whole).
+_MESSAGE_CHARACTERS = 300
 
 
 def _version() -> str:
@@ -41,24 +66,27 @@ def _steps(text: str) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from cadgen.params import ParameterError, load_params
+    from cadgen.params import ParameterError, load_params, stage_problems
     from kinematics.errors import MechanismError
 
     status = EXIT_OK
     for file in args.files:
         try:
-            load_params(file)
+            warnings = stage_problems(load_params(file))
         except ParameterError as exc:
             status = EXIT_PROBLEMS
-            for problem in exc.problems:
-                print(f"{file}: {problem}")
+            for problem in exc.problems:   # a stage's check: an error only where it runs
+                print(f"{file}: {'warning: ' if problem.stage else ''}{problem}")
         except MechanismError as exc:
             # A check that could not finish (e.g. a convergence failure) is still a
             # verdict on this file, not a crash of the whole batch.
             status = EXIT_PROBLEMS
             print(f"{file}: {exc} [{type(exc).__name__}]")
         else:
-            print(f"{file}: ok")
+            for problem in warnings:
+                print(f"{file}: warning: {problem}")
+            print(f"{file}: ok" + (f" ({len(warnings)} warning{'s' * (len(warnings) > 1)})"
+                                   if warnings else ""))
     return status
 
 
@@ -90,13 +118,18 @@ def _cmd_build(args: argparse.Namespace) -> int:
         return EXIT_PROBLEMS
 
     import cadgen.build
+    from cadgen.atomic import OutputDirError
 
     try:
         result = cadgen.build.build(params, output_root=Path(args.output_dir),
                                     effects=args.effects, case=args.case, steps=args.steps,
                                     preset=args.preset)
+    except OutputDirError:
+        raise                       # main() says it, the same way for every command
     except MechanismError as exc:   # stages report their own failures; this is anything else
-        print(f"{args.file}: {exc}", file=sys.stderr)
+        # one line per problem (a DesignError's message spans several)
+        for line in [str(p) for p in getattr(exc, "problems", ())] or [" ".join(str(exc).split())]:
+            print(f"{args.file}: {line}", file=sys.stderr)
         return EXIT_PROBLEMS
     print(result.summary_text())
     return result.exit_code
@@ -142,8 +175,9 @@ def build_parser() -> argparse.ArgumentParser:
     description = ("Build one design: run exactly the stages its scene's effects need (all by "
                    "default), write the outputs atomically under OUTPUT_DIR/<name>/ and print "
                    "the summary. Exit 0 when every target and check passes, 1 when some fail "
-                   "(the report says which), 2 when the file or the design has problems "
-                   "(nothing written).")
+                   "(the report says which), 2 when the file, the design or the output "
+                   "directory has problems (nothing written), 3 on an internal error (a bug: "
+                   "its traceback is saved to a file), 130 when interrupted.")
     for name, help_text in (("build", "build one design: metrics, gears, cam, solids, sweeps, "
                                       "files and report, as its scene asks"),
                             ("analyze", "the same as build (the earlier name)")):
@@ -160,6 +194,118 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line(text: str, limit: int = _MESSAGE_CHARACTERS) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _write_crash_file(error: BaseException, argv: Sequence[str]) -> Path:
+    """Save the traceback, the versions and the command line; the file's path.
+
+    In ``$CADGEN_CRASH_DIR`` (made if missing) or :func:`tempfile.gettempdir`, named
+    ``cadgen-crash-<date>-<time>-<pid>.txt`` (a counter added if that exists).
+    Raises OSError when it cannot be written.
+    """
+    import datetime
+    import platform
+    import tempfile
+    import traceback
+
+    directory = Path(os.environ.get(CRASH_DIR_VARIABLE) or tempfile.gettempdir())
+    directory.mkdir(parents=True, exist_ok=True)
+    now = datetime.datetime.now()
+    stem = f"cadgen-crash-{now:%Y%m%d-%H%M%S}-{os.getpid()}"
+    try:
+        version = _version()
+    except Exception as exc:   # a broken install must not hide the crash being reported
+        version = f"unknown ({type(exc).__name__}: {exc})"
+    text = (f"cadgen {version} internal error at {now.isoformat(timespec='seconds')}\n"
+            f"python {platform.python_version()} ({sys.executable}) on {platform.platform()}\n"
+            f"argv: {[sys.argv[0] if sys.argv else 'cadgen', *argv]!r}\n"
+            f"working directory: {os.getcwd()}\n\n"
+            + "".join(traceback.format_exception(error)))
+    for attempt in range(100):
+        path = directory / (stem + (f"-{attempt}" if attempt else "") + ".txt")
+        try:
+            with open(path, "x", encoding="utf-8") as stream:
+                stream.write(text)
+        except FileExistsError:
+            continue
+        return path
+    raise FileExistsError(f"every crash file name {stem}-*.txt in {directory} is taken")
+
+
+def _internal_error(error: BaseException, argv: Sequence[str]) -> int:
+    """Report an unexpected exception on one line, its traceback in a file: EXIT_INTERNAL."""
+    try:
+        saved = f"traceback saved to {_write_crash_file(error, argv)}"
+    except Exception as exc:
+        saved = f"the traceback could not be saved: {_one_line(exc, 120)}"
+    print(f"cadgen: internal error: {type(error).__name__}: {_one_line(error)} "
+          f"(please report it; {saved})", file=sys.stderr)
+    return EXIT_INTERNAL
+
+
+def _check_output_dir(args: argparse.Namespace) -> None:
+    """An unusable ``--output-dir`` is an error before any work (build, analyze, batch)."""
+    directory = getattr(args, "output_dir", None)
+    if directory is not None:
+        from cadgen.atomic import check_output_root
+
+        check_output_root(directory)
+
+
+class _Interrupts:
+    """While a command runs: Ctrl-C becomes one line and :data:`EXIT_INTERRUPTED`.
+
+    Installs a SIGINT handler (on the main thread, unless SIGINT is ignored, as in a
+    background job) that raises KeyboardInterrupt in this process and remembers it, so
+    an error that follows from the interrupt (a worker pool broken by it) is reported
+    as the interrupt. A worker forked from this process (the build's sweeps and figures)
+    inherits the handler and ends quietly instead: the terminal sends SIGINT to the whole
+    process group, and this process reports it once. A KeyboardInterrupt that Python
+    cannot raise (it landed in a finaliser) is not printed; it is still remembered.
+    """
+
+    def __init__(self):
+        self.owner = os.getpid()
+        self.seen = False
+        self.stopping = False
+        self._previous = None
+
+    def _handle(self, signum, frame):
+        if os.getpid() != self.owner:
+            os._exit(EXIT_INTERRUPTED)
+        self.seen = True
+        if not self.stopping:
+            raise KeyboardInterrupt
+
+    def _unraisable(self, unraisable):
+        if issubclass(unraisable.exc_type, KeyboardInterrupt):
+            self.seen = True
+            return
+        self._previous_hook(unraisable)
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN):
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        self._previous_hook = sys.unraisablehook
+        sys.unraisablehook = self._unraisable
+        return self
+
+    def __exit__(self, *exc_info):
+        import signal
+
+        sys.unraisablehook = self._previous_hook
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+        return False
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line.
 
@@ -171,7 +317,38 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     int
-        The exit status (``EXIT_OK`` or ``EXIT_PROBLEMS``).
+        The exit status: ``EXIT_OK``, ``EXIT_CHECKS_FAILED``, ``EXIT_PROBLEMS``,
+        ``EXIT_INTERNAL`` (an unexpected exception, saved to a crash file) or
+        ``EXIT_INTERRUPTED`` (Ctrl-C). argparse's own exits (``--help``, a bad
+        command line) raise SystemExit as usual.
     """
-    args = build_parser().parse_args(argv)
-    return args.handler(args)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    with _Interrupts() as interrupts:
+        try:
+            args = build_parser().parse_args(argv)
+            _check_output_dir(args)
+            status = args.handler(args)
+        except KeyboardInterrupt:
+            interrupts.stopping = True
+        except BrokenPipeError:
+            # the reader went away (``cadgen build ... | head``): nothing to say, and
+            # nowhere to say it; stdout to /dev/null so the interpreter's flush is quiet
+            try:
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            except (OSError, ValueError):   # stdout is not a file (captured, say)
+                pass
+            return EXIT_BROKEN_PIPE
+        except Exception as error:
+            interrupts.stopping = True
+            if not interrupts.seen:
+                from cadgen.atomic import OutputDirError
+
+                if isinstance(error, OutputDirError):
+                    print(f"cadgen: {error}", file=sys.stderr)
+                    return EXIT_PROBLEMS
+                return _internal_error(error, argv)
+        if interrupts.seen or interrupts.stopping:
+            interrupts.stopping = True
+            print("cadgen: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        return status

@@ -64,7 +64,8 @@ def pricking_design(params):
         a=params.linkage.centre_distance, l=params.linkage.tip_reach,
         exponent=gears.split_exponent, module=gears.module,
         pressure_angle=gears.pressure_angle_rad, addendum=gears.addendum,
-        min_ratio=gears.min_ratio, grid=params.resolution.inverse_grid)
+        min_ratio=gears.min_ratio, grid=params.resolution.inverse_grid,
+        max_scale_change=gears.max_scale_change)
 
 
 def pricking_field(params, design=None):

@@ -6,12 +6,21 @@ the field path a designer should change, never raises for a bad design.
 
 from __future__ import annotations
 
+import dataclasses
 
 from kinematics.errors import ConvergenceError, DesignError, Problem
 from kinematics.metrics import vertical_extremes
 from kinematics.pitch_curves import pair_problems
 
-__all__ = ["design_problems"]
+__all__ = ["design_problems", "CAM_STAGE"]
+
+#: The build stage the duckbill linkage and cam timing checks belong to: a scene that
+#: runs no cam (metrics only) keeps them as warnings (see :func:`cadgen.build.build`).
+CAM_STAGE = "cam"
+
+
+def _in_stage(problems, stage: str) -> list:
+    return [dataclasses.replace(p, stage=stage) for p in problems]
 
 
 def design_problems(params) -> list:
@@ -21,6 +30,11 @@ def design_problems(params) -> list:
     gears' smallest radii clear the cutting limit for the module; the planting
     depth leaves the tip a way out of the soil; the duckbill linkage can open
     the mouth the pot needs; the cam's phases fit the revolution.
+
+    The last two belong to the cam stage (``Problem.stage == "cam"``): the
+    kinematics and the metrics do not need them. The pitch curve's cutting limit
+    stays a problem of every build: the spec rejects such a curve, and the module
+    metric assumes gears that can be cut.
     """
     if params.mechanism == "pricking":
         return _pricking_problems(params)
@@ -50,8 +64,8 @@ def design_problems(params) -> list:
 
 
 def _cam_problems(params, mechanism) -> list:
-    """The duckbill linkage and the cam's timing (checks of the contour itself are reported, not
-    refused: a designer wants to see the cam that fails)."""
+    """The duckbill linkage and the cam's timing, in the cam stage (checks of the contour
+    itself are reported, not refused: a designer wants to see the cam that fails)."""
     from kinematics.metrics import plant_events
 
     from .cam_design import linkage_of, timing_of
@@ -60,13 +74,17 @@ def _cam_problems(params, mechanism) -> list:
     try:
         linkage_of(params)
     except DesignError as error:
-        problems += error.problems
+        problems += _in_stage(error.problems, CAM_STAGE)
     try:
+        # the events are the metrics' own: a problem finding them is no cam problem
         events = plant_events(mechanism.tip_path(), params.field.depth,
                               steps=params.resolution.steps_per_revolution)
+    except DesignError as error:
+        return problems + list(error.problems)
+    try:
         timing_of(params, mechanism, events)
     except DesignError as error:
-        problems += error.problems
+        problems += _in_stage(error.problems, CAM_STAGE)
     return problems
 
 

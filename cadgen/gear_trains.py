@@ -161,10 +161,10 @@ def planting_train(params, mechanism) -> GearTrain:
 def pricking_train(params, design) -> GearTrain:
     """The pricking mechanism's two non-circular stages at the outer dead centre."""
     cutting = params.gears
-    functions, motion, link = design.pitch_functions, design.motion, design.linkage
-    breaks = tuple(motion.breaks)
+    motion, link = design.motion, design.linkage
+    functions, breaks = design.cycle_functions()
     stages = []
-    carrier = float(motion.phi1(0.0))
+    carrier = motion.phi1_start
     line = np.array([math.cos(carrier), math.sin(carrier)])
     centre = np.asarray(link.centre, dtype=float)
     failures = []

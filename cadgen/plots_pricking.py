@@ -62,7 +62,7 @@ def pitch_curves(design):
         closed = np.vstack([xy, xy[:1]])
         ax.plot(closed[:, 0], closed[:, 1], lw=1.4, color="tab:blue")
         carrier = np.degrees(design.motion.sense * (gear.table["carrier_angle"]
-                                                    - design.motion.phi1(0.0)))
+                                                    - design.motion.phi1_start))
         for stretch in gear.concave_stretches:
             low, high = sorted(stretch["carrier_deg"])
             mask = (carrier >= low - 0.5) & (carrier <= high + 0.5)
@@ -84,7 +84,7 @@ def ratio(design):
     stage_1 = design.gears[0].table["radius"] / design.gears[1].table["radius"]
     stage_2 = design.gears[2].table["radius"] / design.gears[3].table["radius"]
     progress = np.degrees(design.motion.sense * (design.grid["carrier_angle"]
-                                                 - design.motion.phi1(0.0)))
+                                                 - design.motion.phi1_start))
     ax.plot(progress, stage_1 * stage_2, lw=1.6, label="total i = 1 - dphi2/dphi1")
     ax.plot(progress, stage_1, lw=1.0, label=f"stage 1, i1 = K i^w (w = {design.exponent:.3f})")
     ax.plot(progress, stage_2, lw=1.0, label="stage 2, i2 = i / i1")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from kinematics.pricking import FORWARD_TOLERANCE
+
 __all__ = ["pricking_report", "pricking_summary"]
 
 
@@ -23,7 +25,7 @@ def pricking_report(params, design, field) -> dict:
     curve = design.curve
     findings = [{"path": f.path, "code": f.code, "message": f.message} for f in design.findings]
     return {
-        "verified": bool(design.forward_deviation < 1e-2),
+        "verified": bool(design.forward_deviation <= FORWARD_TOLERANCE),
         "findings": findings,
         "linkage": {
             "centre_distance_a_mm": linkage.a, "tip_reach_l_mm": linkage.l,
@@ -77,37 +79,43 @@ def pricking_report(params, design, field) -> dict:
 
 
 def pricking_summary(report: dict) -> str:
-    """Plain-text summary: linkage, gears, field table, findings."""
+    """Plain-text summary: linkage, gears, field table, findings (a missing number reads n/a)."""
+    from .summary import _number as n
+
     link, gears, check = report["linkage"], report["gears"], report["verification"]
+    teeth, modules = gears["teeth"], gears["modules_mm"]
     lines = [f"design {report['design']} (pricking mechanism): "
              f"{'verified' if report['verified'] else 'NOT VERIFIED'}, "
              f"{len(report['findings'])} finding{'s' if len(report['findings']) != 1 else ''}",
-             f"linkage: a = {link['centre_distance_a_mm']:.4f} mm, l = {link['tip_reach_l_mm']:.4f}"
-             f" mm, l1 = {link['rocker_l1_mm']:.3f} mm, l2 = {link['needle_l2_mm']:.3f} mm; "
-             f"carrier turns {link['carrier_sense']}",
-             f"gears: w = {gears['split_exponent_w']:.4f}, scale {gears['scale']:.5f}, teeth "
-             f"{gears['teeth'][0]} / {gears['teeth'][1]}, modules "
-             f"{gears['modules_mm'][0]:.4f} / {gears['modules_mm'][1]:.4f} mm, ratio i "
-             f"{gears['total_ratio_min']:.3f}..{gears['total_ratio_max']:.3f}",
-             f"forward check: tip loop reproduced to {check['forward_deviation_mm']:.2e} mm, "
-             f"closure {check['grid_closure_error_rad']:.1e} rad ({check['inverse_grid']} steps)",
+             f"linkage: a = {n(link['centre_distance_a_mm'], '.4f')} mm, l = "
+             f"{n(link['tip_reach_l_mm'], '.4f')} mm, l1 = {n(link['rocker_l1_mm'], '.3f')} mm, "
+             f"l2 = {n(link['needle_l2_mm'], '.3f')} mm; carrier turns {link['carrier_sense']}",
+             f"gears: w = {n(gears['split_exponent_w'], '.4f')}, scale {n(gears['scale'], '.5f')}, "
+             f"teeth {' / '.join(str(t) for t in teeth)}, modules "
+             f"{' / '.join(n(m, '.4f') for m in modules)} mm, ratio i "
+             f"{n(gears['total_ratio_min'], '.3f')}..{n(gears['total_ratio_max'], '.3f')}",
+             f"forward check: tip loop reproduced to {n(check['forward_deviation_mm'], '.2e')} mm, "
+             f"closure {n(check['grid_closure_error_rad'], '.1e')} rad ({check['inverse_grid']} "
+             "steps)",
              ""]
     rows = [("gear", "perimeter", "radius", "min curvature", "convex", "pressure dev.",
              "min convex rho", "undercut")]
     for g in gears["pitch_curves"]:
-        rows.append((g["name"], f"{g['perimeter_mm']:.3f}",
-                     f"{g['radius_min_mm']:.2f}..{g['radius_max_mm']:.2f}",
-                     f"{g['curvature_min_per_mm']:.4f}", "yes" if g["convex"] else "NO",
-                     f"{g['pressure_angle_deviation_max_deg']:.1f} deg",
-                     f"{g['convex_radius_of_curvature_min_mm']:.2f}",
+        rows.append((g["name"], n(g["perimeter_mm"], ".3f"),
+                     f"{n(g['radius_min_mm'], '.2f')}..{n(g['radius_max_mm'], '.2f')}",
+                     n(g["curvature_min_per_mm"], ".4f"), "yes" if g["convex"] else "NO",
+                     f"{n(g['pressure_angle_deviation_max_deg'], '.1f')} deg",
+                     n(g["convex_radius_of_curvature_min_mm"], ".2f", "none convex"),
                      "YES" if g["undercut"] else "no"))
     lines += _table(rows) + [""]
     rows = [("theta", "entry", "exit", "mouth", "in soil", "slow window", "height", "width")]
     for r in report["field"]["per_inclination"]:
-        rows.append((f"{r['inclination_deg']:g} deg", f"{r['needle_entry_angle_deg']:.2f} deg",
-                     f"{r['needle_exit_angle_deg']:.2f} deg", f"{r['hole_mouth_mm']:.2f} mm",
-                     f"{r['time_in_soil_deg']:.1f} deg", f"{r['slow_window_total_deg']:.1f} deg",
-                     f"{r['projected_height_mm']:.1f} mm", f"{r['width_mm']:.1f} mm"))
+        rows.append((f"{n(r['inclination_deg'], 'g')} deg",
+                     f"{n(r['needle_entry_angle_deg'], '.2f')} deg",
+                     f"{n(r['needle_exit_angle_deg'], '.2f')} deg",
+                     f"{n(r['hole_mouth_mm'], '.2f')} mm", f"{n(r['time_in_soil_deg'], '.1f')} deg",
+                     f"{n(r['slow_window_total_deg'], '.1f')} deg",
+                     f"{n(r['projected_height_mm'], '.1f')} mm", f"{n(r['width_mm'], '.1f')} mm"))
     lines += _table(rows)
     for f in report["findings"]:
         lines.append(f"finding [{f['code']}] {f['path']}: {f['message']}")

@@ -47,7 +47,9 @@ def report_dict(params, mechanism, evaluation, case: str = "field") -> dict:
             "tip_velocity_absolute_catching_mm_s": evaluation.speeds["absolute_catching"][s],
         })
     metrics = [{"key": m.key, "label": m.label, "value": m.value, "unit": m.unit,
-                "target": m.target, "passed": m.passed, "spacing_mm": m.spacing}
+                "target": m.target, "passed": m.passed, "verdict": m.verdict,
+                "spacing_mm": m.spacing,
+                **({} if m.bound is None else {"certified_bound": m.bound})}
                for m in evaluation.metrics
                if case == "field" or m.key not in FIELD_METRICS]
     return {
@@ -138,6 +140,7 @@ def assemble_report(run, set_aside: dict) -> dict:
     if sweeps:
         report["sweep"] = sweeps
         _replace_kinematic_estimates(report, sweeps)
+    report["warnings"] = [p.as_dict() for p in getattr(run, "warnings", [])]
     report["accuracy_achieved"] = accuracy_achieved(params, report, values, ok)
     report["stages"] = [record.as_dict() for record in run.records]
     report["failures"] = failures(report)
@@ -157,6 +160,8 @@ def _replace_kinematic_estimates(report: dict, sweeps: dict) -> None:
             metric["value"] = sweep["minimum_mm"]
             metric["label"] = sweep["label"]
             metric["passed"] = sweep["passed"]
+            metric["verdict"] = sweep.get("verdict", "pass" if sweep["passed"] else "fail")
+            metric["certified_bound"] = sweep["certified_bound_mm"]
 
 
 def failures(report: dict) -> list:
@@ -165,8 +170,14 @@ def failures(report: dict) -> list:
     for metric in report.get("metrics", []):
         if not metric["passed"]:
             where = f" at {metric['spacing_mm']:g} mm" if metric.get("spacing_mm") else ""
-            out.append(f"{metric['label']}{where}: {metric['value']:.3f} {metric['unit']} "
-                       f"(target {metric['target']} {metric['unit']})".replace("  ", " "))
+            undecided = ("undecided: the search did not certify, true minimum in "
+                         f"[{metric['certified_bound']:.6g}, {metric['value']:.6g}]; "
+                         if metric.get("verdict") == "undecided" and metric.get("value") is not None
+                         else "")
+            value = "n/a" if metric.get("value") is None else f"{metric['value']:.3f}"
+            out.append(f"{metric['label']}{where}: {value} {metric['unit']} "
+                       f"({undecided}target {metric['target']} {metric['unit']})"
+                       .replace("  ", " "))
     for finding in report.get("findings", []):
         out.append(f"[{finding['code']}] {finding['message']}")
     gear_train = report.get("gear_train", {})
@@ -194,6 +205,22 @@ def failures(report: dict) -> list:
 
 
 
+def _searches_achieved(searches: dict) -> str:
+    """What the minimum searches certified: "certified" only for those that did."""
+    done = [name for name, s in searches.items() if s["certified"]]
+    open_ = [name for name, s in searches.items() if not s["certified"]]
+    parts = []
+    if done:
+        parts.append(f"certified: {', '.join(done)}")
+    for name in open_:
+        search = searches[name]
+        why = (f"budget of {search['evaluations']} evaluations spent"
+               if search.get("budget_spent") else "did not close")
+        parts.append(f"NOT certified: {name} ({why}), true minimum in "
+                     f"[{search['certified_bound']:.9g}, {search['value']:.9g}]")
+    return "minimum searches " + "; ".join(parts)
+
+
 def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
     """What each resolution knob of this build buys, with the basis of the figure.
 
@@ -203,11 +230,12 @@ def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
     """
     rows = []
     if params.mechanism == "planting" and "metrics" in ok:
-        error = values["metrics"].accuracy["closure_centre_distance_error_mm"]
+        accuracy = values["metrics"].accuracy
+        error = accuracy["closure_centre_distance_error_mm"]
         rows.append({"knob": "resolution.steps_per_revolution",
                      "value": params.resolution.steps_per_revolution,
-                     "achieved": "extremes and minima certified (see accuracy); centre distance "
-                                 f"within {error:.1e} mm",
+                     "achieved": f"{_searches_achieved(accuracy['minimum_searches'])}; centre "
+                                 f"distance within {error:.1e} mm",
                      "basis": "certified search and the closure's own error estimate"})
     if "teeth" in ok:
         train = values["teeth"]
@@ -244,8 +272,10 @@ def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
                      "basis": "closed form of the inscribed and circumscribed n-gons"})
     for key, sweep in report.get("sweep", {}).items():
         rows.append({"knob": "resolution.sweep_atol", "value": params.resolution.sweep_atol,
-                     "achieved": f"{sweep['label']}: true minimum in "
-                                 f"[{sweep['certified_bound_mm']:.6f}, {sweep['minimum_mm']:.6f}] mm",
+                     "achieved": f"{sweep['label']}: "
+                                 + ("" if sweep.get("certified", True) else "NOT certified, ")
+                                 + f"true minimum in [{sweep['certified_bound_mm']:.6f}, "
+                                   f"{sweep['minimum_mm']:.6f}] mm",
                      "basis": "certificate of the sweep (speed and acceleration bounds)"})
     return rows
 

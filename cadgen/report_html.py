@@ -78,6 +78,7 @@ figcaption code{color:#6a7482}
 details{margin:8px 0}
 summary{cursor:pointer;font-weight:600}
 .note{color:#556070;font-size:13px}
+.preset{margin:0 0 4px}
 """
 
 
@@ -327,6 +328,34 @@ def _failure_list(failures, shown: int = 3) -> str:
             f'<ul class="issues">{"".join(items[:shown])}</ul>{more}')
 
 
+#: How the report's ``preset.knobs[*].from`` reads on the page.
+_KNOB_SOURCES = {"file": "the parameter file", "preset": "preset {name}"}
+
+
+def _preset_html(preset) -> str:
+    """The accuracy preset: its name over a table of knob, value and where the value came
+    from (the file, or the preset); any other value (an older report's name) as text."""
+    if not isinstance(preset, dict):
+        return _e(preset)
+    name = str(preset.get("name", "?"))
+    knobs = preset.get("knobs") or {}
+    if not isinstance(knobs, dict) or not knobs:
+        return _e(name)
+    rows, classes = [], []
+    for knob, entry in knobs.items():
+        entry = entry if isinstance(entry, dict) else {"value": entry}
+        source = str(entry.get("from", "?"))
+        rows.append([f"<code>{_e(knob)}</code>", _value_html(entry.get("value")),
+                     _e(_KNOB_SOURCES.get(source, source).format(name=name))])
+        classes.append("from-" + re.sub(r"[^a-z0-9]+", "-", source.lower()).strip("-"))
+    from_file = sum(1 for entry in knobs.values()
+                    if isinstance(entry, dict) and entry.get("from") == "file")
+    summary = (f"{_e(name)} ({_plural(len(knobs), 'knob')}: {from_file} from the parameter "
+               f"file, {len(knobs) - from_file} from the preset)")
+    return (f'<div class="preset">{summary}</div>'
+            + _table(["knob", "value", "from"], rows, numeric=(1,), row_classes=classes))
+
+
 def _header(report: dict) -> str:
     checks = overall_checks(report)
     passed = all(ok for _, ok, _ in checks)
@@ -334,10 +363,11 @@ def _header(report: dict) -> str:
     state = "pass" if passed else "fail"
     detail = (f"all {len(checks)} checks met" if passed
               else f"{failed} of {len(checks)} checks failed")
+    warned = len(report.get("warnings") or [])
+    if warned:   # checks of stages this build did not run, listed below the checks
+        detail += f"; {warned} warning{'s' * (warned > 1)} (stages not run)"
     verdict = f'<span class="badge verdict {state}">{state.upper()}</span>{_e(detail)}'
     facts = {"mechanism": f"{report.get('mechanism', '?')} mechanism"}
-    if "preset" in report:
-        facts["preset"] = str(report["preset"])
     if "scene" in report:
         scene = report["scene"]
         effects = ", ".join(scene.get("effects", [])) or "none"
@@ -345,7 +375,11 @@ def _header(report: dict) -> str:
         for effect, reason in scene.get("set_aside", {}).items():
             facts[f"not run: {effect}"] = reason
     facts["versions"] = ", ".join(f"{k} {v}" for k, v in report.get("versions", {}).items())
-    rows = "".join(f"<tr><td>{_e(k)}</td><td>{_e(v)}</td></tr>" for k, v in facts.items())
+    cells = {key: _e(value) for key, value in facts.items()}
+    if "preset" in report:
+        cells = {"mechanism": cells.pop("mechanism"), "preset": _preset_html(report["preset"]),
+                 **cells}
+    rows = "".join(f"<tr><td>{_e(k)}</td><td>{v}</td></tr>" for k, v in cells.items())
     rows += (f'<tr><td>input SHA-256</td><td class="hash">'
              f'{_e(report.get("input_sha256", "—"))}</td></tr>')
     check_rows = [[_e(name), _pass_badge(ok), _e(detail)] for name, ok, detail in checks]
@@ -355,7 +389,18 @@ def _header(report: dict) -> str:
             + _row(_table(["check", "result", "detail"], check_rows,
                           row_classes=["" if ok else "fail" for _, ok, _ in checks]),
                    f'<table class="kv"><tbody>{rows}</tbody></table>')
-            + _failure_list(report.get("failures")) + "</header>")
+            + _failure_list(report.get("failures"))
+            + _warning_list(report.get("warnings")) + "</header>")
+
+
+def _warning_list(warnings) -> str:
+    """Checks of stages this build did not run: shown, not counted against the verdict."""
+    if not warnings:
+        return ""
+    items = [{**w, "path": f"{w.get('path', '')} (stage {w.get('stage', '?')}, not run in this "
+                           "build)"} for w in warnings]
+    return ("<h3>Warnings: checks of stages this build did not run</h3>"
+            + _problem_list(items, state="warn"))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -372,7 +417,10 @@ def _metrics_section(report: dict) -> str:
         spacing = "" if spacing is None else _quantity(spacing, "mm", trim=True)
         unit = m.get("unit", "")
         row = [_e(m["label"]), _e(spacing), _e(_quantity(m["value"], unit)),
-               _e(f"{m['target']} {unit}".strip()), _pass_badge(m["passed"])]
+               _e(f"{m['target']} {unit}".strip()),
+               # a search whose gap [bound, value] straddles the target decides nothing
+               _badge("warn").replace("WARN", "UNDECIDED") if m.get("verdict") == "undecided"
+               else _pass_badge(m["passed"])]
         if estimates:
             estimate = m.get("kinematic_estimate")
             row.append(_e("" if estimate is None else _quantity(estimate, unit)))

@@ -1,9 +1,29 @@
-"""Plain-text summaries of a build's report (what the command line prints)."""
+"""Plain-text summaries of a build's report (what the command line prints).
+
+A report holds only the sections of the stages that ran, and some of its values
+may be None (the pricking mechanism has no kinematic clearance estimate, a
+non-finite number is written as null in report.json): every formatter here takes
+a section as it may come, from a live build or re-read from report.json, and says
+what is missing instead of failing.
+"""
 
 from __future__ import annotations
 
+import math
+
 __all__ = ["summary_text", "format_metrics_table", "format_gear_table", "format_cam",
            "format_solids", "format_clearances", "format_stages"]
+
+#: Printed for a number the report does not have.
+MISSING = "n/a"
+
+
+def _number(value, spec: str, missing: str = MISSING) -> str:
+    """``value`` formatted with ``spec``, or ``missing`` when it is None or not a finite number
+    (infinities print as they are: a bound that does not exist is still a value)."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return missing
+    return format(value, spec)
 
 
 def summary_text(report: dict) -> str:
@@ -33,7 +53,8 @@ def format_stages(report: dict) -> str:
     """The stages that ran, their times and any failure; the verdict."""
     lines = []
     for record in report.get("stages", []):
-        line = f"  {record['stage']:<18} {record['status']:<8} {record['seconds']:8.3f} s"
+        seconds = _number(record["seconds"], "8.3f")
+        line = f"  {record['stage']:<18} {record['status']:<8} {seconds:>8} s"
         if record["message"]:
             line += f"  {record['message']}"
         lines.append(line)
@@ -45,16 +66,23 @@ def format_stages(report: dict) -> str:
 
 
 def format_clearances(sweep: dict) -> str:
-    """The FCL clearances beside their kinematic estimates."""
+    """The FCL clearances beside their kinematic estimates (when the mechanism has one)."""
     lines = []
     for key, row in sweep.items():
         ranges = row.get("interference_ranges_deg") or []
+        bound = _number(row.get("certified_bound_mm"), ".3f")
+        bound = (f"certified >= {bound}" if row.get("certified", True)
+                 else f"NOT certified, bound {bound}")
+        nearest = row.get("nearest") or ()
+        where = (f" at carrier angle {_number(row.get('carrier_angle_deg'), '.2f')} deg"
+                 + (f", {nearest[0]} / {nearest[1]}" if len(nearest) == 2 else ""))
+        estimate = row.get("kinematic_estimate_mm")
+        estimate = ("no kinematic estimate for this mechanism" if estimate is None
+                    else f"kinematic estimate {_number(estimate, '.3f')} mm")
         lines.append(
-            f"{row['label']}: {row['minimum_mm']:.3f} mm (certified >= "
-            f"{row['certified_bound_mm']:.3f}) at carrier angle {row['carrier_angle_deg']:.2f} deg, "
-            f"{row['nearest'][0]} / {row['nearest'][1]}; kinematic estimate "
-            f"{row['kinematic_estimate_mm']:.3f} mm; target > {row['target_mm']:g} mm: "
-            f"{'pass' if row['passed'] else 'FAIL'}"
+            f"{row.get('label', key)}: {_number(row.get('minimum_mm'), '.3f')} mm ({bound})"
+            f"{where}; {estimate}; target > {_number(row.get('target_mm'), 'g')} mm: "
+            f"{'pass' if row.get('passed') else 'FAIL'}"
             + (f"; IN INTERFERENCE over {', '.join(f'{a:.1f}..{b:.1f}' for a, b in ranges)} deg"
                if ranges else ""))
     return "\n".join(lines)
@@ -64,10 +92,12 @@ def format_metrics_table(report: dict) -> str:
     """Plain-text table of the metrics against their targets."""
     rows = [("metric", "spacing", "value", "target", "")]
     for m in report["metrics"]:
-        spacing = f"{m['spacing_mm']:g} mm" if m["spacing_mm"] is not None else ""
-        value = f"{m['value']:.3f} {m['unit']}".strip()
-        rows.append((m["label"], spacing, value, f"{m['target']} {m['unit']}".strip(),
-                     "pass" if m["passed"] else "FAIL"))
+        spacing = f"{_number(m['spacing_mm'], 'g')} mm" if m.get("spacing_mm") is not None else ""
+        value = f"{_number(m.get('value'), '.3f')} {m['unit']}".strip()
+        target = f"{m['target']} {m['unit']}".strip() if m.get("target") is not None else ""
+        status = ("UNDECIDED" if m.get("verdict") == "undecided"   # a search's gap straddles it
+                  else "pass" if m["passed"] else "FAIL")
+        rows.append((m["label"], spacing, value, target, status))
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
     lines = [f"design {report['design']} ({report['mechanism']} mechanism): "
              f"{'all targets met' if report['passed'] else 'TARGETS MISSED'}"]
@@ -75,39 +105,55 @@ def format_metrics_table(report: dict) -> str:
         lines.append("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
         if k == 0:
             lines.append("  ".join("-" * w for w in widths))
-    ev = report["events"]
-    att = ev["attitude_deg"]
     lines.append("")
-    lines.append("attitude Psi (deg): catching {catching:.3f}, entry {entry:.3f}, lowest {lowest:.3f}, "
-                 "exit {exit:.3f}".format(**att))
-    vl = ev["tip_velocity_relative_lowest_mm_s"]
-    lines.append(f"tip velocity at the lowest point, relative: ({vl[0]:.2f}, {vl[1]:.2f}) mm/s "
-                 f"at {ev['carrier_speed_rpm']:g} r/min")
-    for row in report["per_spacing"]:
-        v = row["tip_velocity_absolute_lowest_mm_s"]
-        lines.append(f"  absolute at S = {row['spacing_mm']:g} mm: ({v[0]:.2f}, {v[1]:.2f}) mm/s")
-    lines.append(f"catching-to-planting height: {ev['catch_to_plant_height_mm']:.3f} mm")
+    ev = report.get("events")
+    if ev is None:   # a bench run: no soil, so no entry, exit or absolute motion
+        lines.append("bench run: no soil, so "
+                     "no attitude at entry and exit, no holes and no absolute tip speeds")
+    else:
+        att = {key: _number(value, ".3f") for key, value in ev["attitude_deg"].items()}
+        lines.append("attitude Psi (deg): catching {catching}, entry {entry}, lowest {lowest}, "
+                     "exit {exit}".format(**att))
+        vl = ev["tip_velocity_relative_lowest_mm_s"]
+        lines.append(f"tip velocity at the lowest point, relative: ({_number(vl[0], '.2f')}, "
+                     f"{_number(vl[1], '.2f')}) mm/s at {_number(ev['carrier_speed_rpm'], 'g')} "
+                     "r/min")
+        for row in report.get("per_spacing", []):
+            v = row["tip_velocity_absolute_lowest_mm_s"]
+            lines.append(f"  absolute at S = {_number(row['spacing_mm'], 'g')} mm: "
+                         f"({_number(v[0], '.2f')}, {_number(v[1], '.2f')}) mm/s")
+        lines.append("catching-to-planting height: "
+                     f"{_number(ev['catch_to_plant_height_mm'], '.3f')} mm")
     d = report["derived"]
-    lines.append(f"centre distance a = {d['centre_distance_a_mm']:.6f} mm, "
-                 f"module {d['module_mm']:.4f} mm, ratio {d['ratio_min']:.4f}..{d['ratio_max']:.4f}")
+    lines.append(f"centre distance a = {_number(d['centre_distance_a_mm'], '.6f')} mm, "
+                 f"module {_number(d['module_mm'], '.4f')} mm, ratio "
+                 f"{_number(d['ratio_min'], '.4f')}..{_number(d['ratio_max'], '.4f')}")
     return "\n".join(lines)
 
 
 def format_cam(cam: dict) -> str:
     """Plain-text summary of the duckbill cam and its checks."""
     events = cam["carrier_angle_deg"]
-    lines = [f"cam: opening {cam['opening_angle_deg']:.2f} deg (mouth {cam['mouth_mm']:.1f} mm for "
-             f"{cam['required_mouth_mm']:.1f} mm), push-rod stroke {cam['push_rod_stroke_mm']:.2f} "
-             f"mm, roller lift {cam['roller_lift_mm']:.2f} mm",
-             f"     opens {events['opening'][0]:.1f}..{events['opening'][1]:.1f} deg, closes "
-             f"{events['closing'][0]:.1f}..{events['closing'][1]:.1f} deg (lowest point "
-             f"{events['lowest']:.1f}, exit {events['exit']:.1f}, seedling cleared "
-             f"{events['seedling_cleared']:.1f})",
-             f"     pressure angle max {cam['pressure_angle_max_deg']:.2f} deg, smallest convex "
-             f"pitch radius {cam['pitch_radius_convex_min_mm']:.2f} mm for a "
-             f"{cam['roller_radius_mm']:g}-mm roller"]
+
+    def deg(value):
+        return _number(value, ".1f")
+
+    lines = [f"cam: opening {_number(cam['opening_angle_deg'], '.2f')} deg (mouth "
+             f"{_number(cam['mouth_mm'], '.1f')} mm for {_number(cam['required_mouth_mm'], '.1f')}"
+             f" mm), push-rod stroke {_number(cam['push_rod_stroke_mm'], '.2f')} mm, roller lift "
+             f"{_number(cam['roller_lift_mm'], '.2f')} mm",
+             f"     opens {deg(events['opening'][0])}..{deg(events['opening'][1])} deg, closes "
+             f"{deg(events['closing'][0])}..{deg(events['closing'][1])} deg (lowest point "
+             f"{deg(events.get('lowest'))}, exit {deg(events.get('exit'))}, seedling cleared "
+             f"{deg(events.get('seedling_cleared'))})",
+             f"     pressure angle max {_number(cam['pressure_angle_max_deg'], '.2f')} deg, "
+             f"smallest convex pitch radius "
+             f"{_number(cam['pitch_radius_convex_min_mm'], '.2f', 'none (no convex stretch)')} mm "
+             f"for a {_number(cam['roller_radius_mm'], 'g')}-mm roller"]
     for problem in cam["problems"]:
         lines.append(f"     FAIL [{problem['code']}] {problem['message']}")
+    if cam.get("not_written"):
+        lines.append(f"     {cam['not_written']}")
     return "\n".join(lines)
 
 
@@ -116,17 +162,20 @@ def format_solids(solids: dict) -> str:
     parts = solids["parts"]
     instances = sum(p["instances"] for p in parts)
     lines = [f"solids: {len(parts)} parts ({instances} placed), total mass "
-             f"{solids['total_mass_kg']:.2f} kg at {solids['density_kg_m3']:g} kg/m3, assembly at "
-             f"carrier angle {solids['assembly']['carrier_angle_deg']:g} deg"]
+             f"{_number(solids['total_mass_kg'], '.2f')} kg at "
+             f"{_number(solids['density_kg_m3'], 'g')} kg/m3, assembly at carrier angle "
+             f"{_number(solids['assembly']['carrier_angle_deg'], 'g')} deg"]
     for row in solids["enclosure"]:
-        margin = row["smallest_margin_mm"]
+        margin = row.get("smallest_margin_mm")
         if margin is None:
             lines.append(f"     {row['housing']}: no gears were cut, so its size is a coarse "
                          "estimate (each gear within the centre distance)")
             continue
         state = ("encloses its gears" if row["gears_enclosed"] else "DOES NOT enclose its gears")
-        lines.append(f"     {row['housing']} {state} (smallest margin {margin:.2f} mm, "
-                     f"{row['nearest_gear']})")
+        axial = ("" if row.get("axial_fit", True)
+                 else "; the gears' faces do not fit between its floor and roof")
+        lines.append(f"     {row['housing']} {state} (smallest margin {_number(margin, '.2f')} mm, "
+                     f"{row.get('nearest_gear') or MISSING}{axial})")
     return "\n".join(lines)
 
 
@@ -134,8 +183,8 @@ def format_gear_table(gear_train: dict) -> str:
     """Plain-text table of the generated gears and their meshes."""
     rows = [("gear", "teeth", "module", "cutter", "undercut teeth", "pointed", "problems")]
     for g in gear_train["gears"]:
-        rows.append((g["gear"], str(g["teeth"]), f"{g['module_mm']:.4f}", g["cutter"] +
-                     (f" (z={g['shaper_teeth']})" if g["shaper_teeth"] else ""),
+        rows.append((g["gear"], str(g["teeth"]), _number(g["module_mm"], ".4f"), g["cutter"] +
+                     (f" (z={g['shaper_teeth']})" if g.get("shaper_teeth") else ""),
                      str(len(g["undercut_teeth"])), str(len(g["pointed_teeth"])),
                      ", ".join(p["code"] for p in g["problems"]) or "-"))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
@@ -143,16 +192,16 @@ def format_gear_table(gear_train: dict) -> str:
     lines.insert(1, "  ".join("-" * w for w in widths))
     lines.append("")
     for m in gear_train["meshes"]:
-        relief = m["tip_relief"]
+        relief = m.get("tip_relief")
+        backlash = m.get("backlash_deg") or (None, None)
         lines.append(
             f"mesh {m['stage']}: {m['interference_poses']} interfering poses of {m['poses']} "
-            f"(largest overlap {m['overlap_area_max_mm2']:.1e} mm2), backlash "
-            f"{m['backlash_deg'][0]:.1e}..{m['backlash_deg'][1]:.1e} deg, transmission error "
-            f"{m['transmission_error_pp_deg']:.1e} deg p-p"
-            + (f"; tip relief on the {relief['gear']} gear: {relief['removed_area_mm2']:.3f} mm2, "
-               f"up to {relief['depth_mm']:.3f} mm deep" if relief else ""))
+            f"(largest overlap {_number(m.get('overlap_area_max_mm2'), '.1e')} mm2), backlash "
+            f"{_number(backlash[0], '.1e')}..{_number(backlash[1], '.1e')} deg, transmission "
+            f"error {_number(m.get('transmission_error_pp_deg'), '.1e')} deg p-p"
+            + (f"; tip relief on the {relief['gear']} gear: "
+               f"{_number(relief['removed_area_mm2'], '.3f')} mm2, up to "
+               f"{_number(relief['depth_mm'], '.3f')} mm deep" if relief else ""))
     for f in gear_train["failures"]:
         lines.append(f"NOT CUT [{f['code']}] {f['message']}")
     return "\n".join(lines)
-
-

@@ -77,7 +77,7 @@ def _pitch_tables(run) -> dict:
     if run.params.mechanism == "pricking":
         design = run.values["kinematics"]
         v = np.linspace(0.0, design.motion.period, CURVE_SAMPLES, endpoint=False)
-        gears = design.pitch_functions
+        gears = design.cycle_functions()[0]   # from the outer dead centre, as the train
     else:
         from .gear_trains import planting_pair
 

@@ -82,15 +82,35 @@ def _centre_line(mechanism: PlantingMechanism, phi, arm):
     return np.stack([points[name] for name in CENTRE_LINE], axis=1)
 
 
-def arm_distance(mechanism: PlantingMechanism, *, steps: int = tol.STEPS_PER_REVOLUTION
-                 ) -> CertifiedMinimum:
+def arm_distance(mechanism: PlantingMechanism, *, steps: int = tol.STEPS_PER_REVOLUTION,
+                 atol: float = tol.ARM_DISTANCE_ATOL,
+                 max_evaluations: int = tol.ARM_DISTANCE_EVALUATIONS) -> CertifiedMinimum:
     """Certified least distance between the two arms' centre lines C-E-P1-N.
 
     The pair's distance repeats every half revolution (the arms swap), so half a
-    revolution is searched with ``steps // 2`` samples. Bounds: points along a
-    segment move no faster than its fastest end, so the relative speed is at
-    most twice the tip's speed bound; the distance's second derivative is at
-    most ``A + V^2 / d`` (relative acceleration and speed, distance floor).
+    revolution is searched with ``steps // 2`` samples. Where the centre lines
+    cross the distance is 0 over a whole range of carrier angles: it is never
+    negative (``floor = 0``), so a crossing found is the certified minimum.
+
+    Bounds (``V``, ``A``: relative speed and acceleration of any two points of the
+    arms; a point along a segment moves no faster than its faster end, so each is
+    twice the largest bound of the centre-line points):
+
+    - first order, ``|d'| <= V``;
+    - second order, ``d'' <= A + V^2 / d`` where ``d > 0``: unbounded where the
+      arms touch, where the distance has a kink;
+    - second order on the squared distance, which stays valid there: for each pair
+      of points ``w(t)``, ``(|w|^2)'' = 2 |w'|^2 + 2 w.w'' <= 2 V^2 + 2 |w| A``, so on an
+      interval of width ``h`` with end values at least ``m``,
+      ``d^2 >= m^2 - (V^2 + A (m + V h)) h^2 / 4``.
+
+    Parameters
+    ----------
+    atol : float
+        The search closes when the bound is within this of the value (mm).
+    max_evaluations : int
+        Budget of distance evaluations; a search that spends it reports
+        ``certified = False`` with the gap ``[bound, value]`` it reached.
     """
     speed = 2.0 * max(mechanism.speed_bound(p) for p in CENTRE_LINE)
     accel = 2.0 * max(mechanism.acceleration_bound(p) for p in CENTRE_LINE)
@@ -103,8 +123,15 @@ def arm_distance(mechanism: PlantingMechanism, *, steps: int = tol.STEPS_PER_REV
             return np.where(first_order_bounds > 0.0,
                             accel + speed**2 / first_order_bounds, np.inf)
 
+    def squared_bound(f_left, f_right, width):
+        nearest = np.minimum(f_left, f_right)
+        squared = nearest**2 - (speed**2 + accel * (nearest + speed * width)) * width**2 / 4.0
+        return np.sqrt(np.maximum(squared, 0.0))
+
     return certified_minimum(distance, 0.0, np.pi, steps=max(2, steps // 2),
-                             lipschitz=speed, curvature=curvature)
+                             lipschitz=speed, curvature=curvature, floor=0.0,
+                             interval_bound=squared_bound, atol=atol,
+                             max_evaluations=max_evaluations)
 
 
 @dataclass(frozen=True)

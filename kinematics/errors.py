@@ -25,15 +25,28 @@ class Problem:
         Short machine-readable kind, e.g. ``"unknown_key"``, ``"pointed_pitch_curve"``.
     message : str
         A sentence for a person: the bad value and why it is bad.
+    stage : str, optional
+        The build stage the check belongs to (``"cam"`` for the duckbill linkage),
+        or None for a problem no build can go past. A build whose scene does not
+        run that stage keeps it as a warning.
     """
 
     path: str
     code: str
     message: str
+    stage: str | None = None
 
     def __str__(self) -> str:
         where = self.path or "<file>"
-        return f"{where}: {self.message} [{self.code}]"
+        stage = f" (stage {self.stage})" if self.stage else ""
+        return f"{where}: {self.message} [{self.code}]{stage}"
+
+    def as_dict(self) -> dict:
+        """``{"path", "code", "message"}`` plus ``"stage"`` when it has one."""
+        out = {"path": self.path, "code": self.code, "message": self.message}
+        if self.stage:
+            out["stage"] = self.stage
+        return out
 
 
 class MechanismError(Exception):

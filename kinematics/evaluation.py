@@ -17,6 +17,7 @@ from . import tolerances as tol
 from .clearance import HousingCircle, KinematicClearance
 from .metrics import PlantEvents, hole_metrics, plant_events
 from .planting import PlantingMechanism
+from .sweep import Verdict
 
 __all__ = ["Targets", "MetricResult", "PlantingEvaluation", "evaluate_planting",
            "default_housing_circles"]
@@ -37,7 +38,11 @@ class Targets:
 
 @dataclass(frozen=True)
 class MetricResult:
-    """One metric's value against its target."""
+    """One metric's value against its target.
+
+    ``verdict`` is ``passed`` spelled out, or ``"undecided"`` for a searched minimum
+    whose certified gap ``[bound, value]`` straddles the target (then not passed).
+    """
 
     key: str
     label: str
@@ -46,6 +51,13 @@ class MetricResult:
     target: str
     passed: bool
     spacing: float | None = None
+    verdict: str = ""
+    bound: float | None = None     # a searched minimum's certified lower bound
+
+    def __post_init__(self):
+        # a plain comparison is certain; a search's verdict may be "undecided" (not passed)
+        if not self.verdict:
+            object.__setattr__(self, "verdict", Verdict.PASS if self.passed else Verdict.FAIL)
 
 
 @dataclass(frozen=True)
@@ -99,6 +111,13 @@ def default_housing_circles(mechanism: PlantingMechanism, module: float, allowan
             "B": R * mechanism.i13 + m_c + outer1, "C": R + m_c + outer1}
     return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
             + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])
+
+
+def _searched(key, label, search, target) -> MetricResult:
+    """A minimum that must exceed ``target``, judged on its certified gap ``[bound, value]``."""
+    verdict = search.verdict_above(target)
+    return MetricResult(key, label, search.value, "mm", f"> {target:g}",
+                        verdict == Verdict.PASS, verdict=verdict, bound=search.bound)
 
 
 def _deg(x):
@@ -177,11 +196,8 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         MetricResult("angle_difference", "entry/exit angle difference", angle_difference, "deg",
                      f"0-{t.angle_difference_max_deg:g}",
                      angle_difference <= t.angle_difference_max_deg),
-        MetricResult("arm_distance", model.arm_label, arms.value, "mm",
-                     f"> {t.arm_distance_min:g}", arms.value > t.arm_distance_min),
-        MetricResult("ground_clearance", model.ground_label, clearance.value, "mm",
-                     f"> {t.ground_clearance_min:g}",
-                     clearance.value > t.ground_clearance_min),
+        _searched("arm_distance", model.arm_label, arms, t.arm_distance_min),
+        _searched("ground_clearance", model.ground_label, clearance, t.ground_clearance_min),
         MetricResult("module", "non-circular gear module", module, "mm",
                      f"> {t.module_min:g}", module > t.module_min),
         MetricResult("soil_penetrations", "soil penetrations per plant", float(events.penetrations),
@@ -197,6 +213,7 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         "steps_per_revolution": steps,
         "minimum_searches": {
             name: {"value": r.value, "certified_bound": r.bound, "certified": r.certified,
+                   "gap": r.gap, "atol": r.atol, "budget_spent": r.budget_spent,
                    "refined_intervals": r.refined_intervals, "evaluations": r.evaluations}
             for name, r in (("lowest_point", events.lowest_search),
                             ("highest_point", events.highest_search),

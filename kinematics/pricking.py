@@ -40,6 +40,30 @@ TWO_PI = 2.0 * np.pi
 EQUAL_PERIMETER = "equal-perimeter"
 #: |c| may exceed 1 by this much from round-off on the curve before the point is unreachable.
 REACH_TOL = 1e-9
+#: The tip loop rebuilt from the tabulated pitch curves must stay this close to the curve (mm).
+FORWARD_TOLERANCE = 1e-2
+
+
+def travel_direction_problems(curve: ClosedCurve, path: str = "trajectory.points") -> list:
+    """The tip must move backwards (-x) relative to the machine at the bottom of its loop.
+
+    The points' order is the tip's order in time, and x is forward travel: at the
+    bottom the tip must run against the travel, so that over the ground it is
+    nearly still while it pricks. The same points in the reverse order give the
+    same gears with the carrier turning the other way and the needle dragged
+    forward through the soil (a mouth of hundreds of mm): rejected, not renumbered.
+    """
+    u = curve.polyline_parameters()
+    lowest = float(u[np.argmin(curve(u)[:, 1])])
+    velocity = curve(lowest, 1)
+    if velocity[0] < 0.0:
+        return []
+    return [Problem(path, "loop_runs_forward",
+                    f"in the points' order the tip moves forward (+x, the direction of travel) "
+                    f"at the bottom of the loop (near {curve.describe(lowest)}), so it would be "
+                    "dragged through the soil instead of standing nearly still over it: list the "
+                    "points in the reverse order (the points' order is the tip's order in time, "
+                    "and x is forward travel)")]
 
 
 @dataclass(frozen=True)
@@ -86,16 +110,19 @@ def link_lengths(curve: ClosedCurve, centre, rocker: float, *, a: float | None =
 class CarrierMotion:
     """Carrier and needle angles along the loop for one assembly mode.
 
-    ``v`` is the curve parameter measured from the Rmax dead centre
-    (``u = u_max + v``, ``v`` in ``[0, period)``); the Rmin dead centre is at
-    ``v_min``. ``sense`` is +1 when the carrier turns counter-clockwise as the
-    tip goes round the loop in the points' order.
+    ``v`` is the curve's own parameter (``v`` in ``[0, period)``, 0 at Q1); the
+    Rmax and Rmin dead centres are at ``v_max`` and ``v_min``. They are not
+    break points: the angles are analytic across them, and only the knots
+    (the type-value points) break the fits. ``sense`` is +1 when the carrier
+    turns counter-clockwise as the tip goes round the loop in the points' order.
+    Carrier *progress* is measured from the Rmax dead centre (:meth:`progress`).
     """
 
     curve: ClosedCurve
     linkage: Linkage
     sense: int
     v_min: float
+    v_max: float
     breaks: np.ndarray
     phi1: PiecewiseChebyshev = field(repr=False)
     phi2: PiecewiseChebyshev = field(repr=False)
@@ -107,7 +134,25 @@ class CarrierMotion:
         return self.curve.period
 
     def u(self, v):
-        return np.mod(self.linkage.u_max + np.asarray(v, dtype=float), self.period)
+        """Curve parameter at motion parameter ``v``."""
+        return np.mod(np.asarray(v, dtype=float), self.period)
+
+    def v(self, u):
+        """Motion parameter at curve parameter ``u`` (the inverse of :meth:`u`)."""
+        return np.mod(np.asarray(u, dtype=float), self.period)
+
+    def cycle(self, v):
+        """Cycle parameter ``tau`` from the Rmax dead centre, in ``[0, period)``, at ``v``."""
+        return np.mod(np.asarray(v, dtype=float) - self.v_max, self.period)
+
+    @property
+    def phi1_start(self) -> float:
+        """Carrier angle at the Rmax dead centre, where carrier progress starts."""
+        return float(self.phi1(self.v_max))
+
+    def progress(self, v):
+        """Carrier turn since the Rmax dead centre (rad, in ``[0, 2 pi)``), at ``v`` in ``[0, period]``."""
+        return np.mod(self.sense * (self.phi1(v) - self.phi1_start), TWO_PI)
 
     def ratio(self, v):
         """Total relative ratio of the planet to the carrier, ``i = 1 - dphi2/dphi1``."""
@@ -120,8 +165,11 @@ class CarrierMotion:
                 + self.linkage.l * _unit(self.phi2(v)))
 
     def invert(self, phi1_values, iterations: int = 60):
-        """Curve parameters ``v`` where the carrier angle takes ``phi1_values`` (monotone)."""
-        target = np.asarray(phi1_values, dtype=float)
+        """Curve parameters ``v`` where the carrier angle takes ``phi1_values`` (any turn)."""
+        start = float(self.phi1(0.0))
+        # the same carrier position within the turn that v in [0, period] covers
+        target = start + self.sense * np.mod(
+            self.sense * (np.asarray(phi1_values, dtype=float) - start), TWO_PI)
         low = np.zeros_like(target)
         high = np.full_like(target, self.period)
         for _ in range(iterations):  # vectorized bisection on the monotone phi1
@@ -140,56 +188,112 @@ class _RadialGaps:
 
     Near a dead centre ``R`` is within round-off of ``l +- 2a`` and the plain
     difference loses every digit that ``arccos`` needs (it depends on the square
-    root of the gap). Inside the dead centre's spline span the curve is a
-    polynomial, so ``p(u) - p(u*)`` is an exact finite Taylor series and
-    ``R*^2 - R^2 = -d.(2 p* + d)`` keeps full relative precision.
+    root of the gap). Instead ``d = p(u) - p(u*)`` is summed exactly from the
+    spline's polynomial pieces, chained knot to knot from the dead centre ``u*``
+    (a type-value point a hundredth of a millimetre from it puts a knot there),
+    and ``R^2 - R*^2 = d.(2 p* + d)`` keeps full relative precision. When a and
+    l are derived from the curve, ``R* = l +- 2a`` exactly: the one rounding of
+    ``l - 2a`` would otherwise make the gap negative over a micrometre, clamp the
+    arccos and put a kink in the carrier angle.
     """
 
     def __init__(self, curve: ClosedCurve, linkage: Linkage):
         self.curve = curve
         self.centre = np.asarray(linkage.centre, dtype=float)
         self.a, self.l = linkage.a, linkage.l
+        knots = curve.knots
+        middles = 0.5 * (knots[:-1] + knots[1:])
+        factorials = np.cumprod(np.concatenate([[1.0], np.arange(1.0, curve.degree + 1)]))
+        # power coefficients of every span's polynomial about its middle: (spans, degree + 1, 2)
+        self._middle_coefficients = np.stack(
+            [curve(middles, k) / factorials[k] for k in range(curve.degree + 1)], axis=1)
+        self._middles = middles
+        outer, inner = self.l + 2 * self.a, self.l - 2 * self.a
         self.expansions = []
-        for u_star in (linkage.u_max, linkage.u_min):
-            derivatives = [curve(u_star, k) for k in range(1, curve.degree + 1)]
-            self.expansions.append((self._span(u_star), u_star, curve(u_star) - self.centre,
-                                    derivatives))
+        for u_star, circle in ((linkage.u_max, outer), (linkage.u_min, inner)):
+            rel_star = curve(u_star) - self.centre
+            r_star = float(np.linalg.norm(rel_star))
+            offset = 0.0 if linkage.derived else (circle - r_star if circle == outer
+                                                   else r_star - circle)
+            self.expansions.append((rel_star, r_star, offset, *self._anchored(u_star)))
 
     def _span(self, u):
         knots = self.curve.knots
         return np.clip(np.searchsorted(knots, np.mod(u, self.curve.period), side="right") - 1,
                        0, len(knots) - 2)
 
+    def _shifted(self, span: int, anchor: float) -> np.ndarray:
+        """Power coefficients of span ``span``'s polynomial about ``anchor``: (degree + 1, 2)."""
+        from math import comb
+
+        degree = self.curve.degree
+        h = anchor - self._middles[span]
+        shift = np.array([[comb(q, r) * h ** (q - r) if q >= r else 0.0
+                           for q in range(degree + 1)] for r in range(degree + 1)])
+        return shift @ self._middle_coefficients[span]
+
+    @staticmethod
+    def _increment(coefficients, step):
+        """``P(anchor + step) - P(anchor)`` from power coefficients, constant left out."""
+        step = np.asarray(step, dtype=float)[..., None]
+        total = np.zeros(step.shape[:-1] + (2,)) + coefficients[..., -1, :]
+        for q in range(coefficients.shape[-2] - 2, 0, -1):
+            total = total * step + coefficients[..., q, :]
+        return total * step
+
+    def _anchored(self, u_star: float):
+        """Per span: an anchor parameter, ``p(anchor) - p(u*)`` and coefficients about the anchor.
+
+        The anchor is ``u*`` in its own span, else the span's end nearer ``u*``
+        along the chain; going half the loop forwards and the rest backwards
+        keeps every chain short.
+        """
+        knots = self.curve.knots
+        count = len(knots) - 1
+        own = int(self._span(np.array([u_star]))[0])
+        anchors = np.empty(count)
+        offsets = np.zeros((count, 2))
+        coefficients = np.empty((count, self.curve.degree + 1, 2))
+        anchors[own], coefficients[own] = u_star, self._shifted(own, u_star)
+        for direction, steps in ((1, count // 2), (-1, count - count // 2 - 1)):
+            previous = own
+            for step in range(1, steps + 1):
+                span = (own + direction * step) % count
+                end = knots[previous + 1] if direction > 0 else knots[previous]
+                offsets[span] = offsets[previous] + self._increment(
+                    coefficients[previous], end - anchors[previous])
+                anchors[span] = knots[span] if direction > 0 else knots[span + 1]
+                coefficients[span] = self._shifted(span, anchors[span])
+                previous = span
+        return anchors, offsets, coefficients
+
     def __call__(self, u):
         """``(R, l + 2a - R, R - (l - 2a))`` at curve parameters ``u``."""
         u = np.mod(np.asarray(u, dtype=float), self.curve.period)
-        rel = self.curve(u) - self.centre
-        radius = np.linalg.norm(rel, axis=-1)
-        outer, inner = self.l + 2 * self.a, self.l - 2 * self.a
-        gaps = [outer - radius, radius - inner]
+        radius = np.linalg.norm(self.curve(u) - self.centre, axis=-1)
         spans = self._span(u)
-        for index, (span, u_star, rel_star, derivatives) in enumerate(self.expansions):
-            near = spans == span
-            if not near.any():
-                continue
-            step = (u[near] - u_star)[:, None]
-            delta = sum(d * step ** (k + 1) / np.prod(np.arange(1, k + 2))
-                        for k, d in enumerate(derivatives))
-            r_star = float(np.linalg.norm(rel_star))
-            change = np.einsum("ij,ij->i", delta, 2 * rel_star + delta)  # R^2 - R*^2
-            if index == 0:   # outer dead centre: gap = (outer - R*) + (R*^2 - R^2)/(R* + R)
-                gaps[0][near] = (outer - r_star) - change / (r_star + radius[near])
-            else:            # inner dead centre: gap = (R* - inner) + (R^2 - R*^2)/(R + R*)
-                gaps[1][near] = (r_star - inner) + change / (r_star + radius[near])
+        gaps = []
+        for index, (rel_star, r_star, offset, anchors, offsets, coefficients) in enumerate(
+                self.expansions):
+            delta = offsets[spans] + self._increment(coefficients[spans], u - anchors[spans])
+            change = np.einsum("...j,...j->...", delta, 2 * rel_star + delta)  # R^2 - R*^2
+            # outer: gap = (outer - R*) + (R*^2 - R^2)/(R* + R); inner: (R* - inner) + (R^2 - R*^2)/(R + R*)
+            sign = -1.0 if index == 0 else 1.0
+            gaps.append(offset + sign * change / (r_star + radius))
         return radius, gaps[0], gaps[1]
 
 
 def _mode_functions(curve: ClosedCurve, linkage: Linkage, sense: int):
-    """phi1(v) and phi2(v) for one branch assignment: +sense on [0, v_min), -sense after."""
+    """phi1(v) and phi2(v) for one branch assignment: +sense from the Rmax dead centre to Rmin.
+
+    ``w`` is the parameter measured from the Rmax dead centre; the arccos branch is
+    ``+sense`` on ``[0, w_min)`` and ``-sense`` after. ``v`` runs from Q1, so the
+    stretch before the Rmax dead centre belongs to the previous turn (``-2 pi sense``).
+    """
     centre = np.asarray(linkage.centre)
     a, l = linkage.a, linkage.l
     period = curve.period
-    v_min = float(np.mod(linkage.u_min - linkage.u_max, period))
+    w_min = float(np.mod(linkage.u_min - linkage.u_max, period))
     reference = np.mean(curve.polyline(), axis=0) - centre
     ref_angle = float(np.arctan2(reference[1], reference[0]))
     ref_dir = _unit(ref_angle)
@@ -197,7 +301,9 @@ def _mode_functions(curve: ClosedCurve, linkage: Linkage, sense: int):
 
     def angles(v):
         v = np.asarray(v, dtype=float)
-        u = linkage.u_max + v
+        u = v
+        w = np.mod(v - linkage.u_max, period)
+        earlier = v < linkage.u_max
         rel = curve(u) - centre
         radius, outer_gap, inner_gap = gaps(u)
         alpha = ref_angle + np.arctan2(_cross(ref_dir, rel), rel @ ref_dir)
@@ -206,25 +312,34 @@ def _mode_functions(curve: ClosedCurve, linkage: Linkage, sense: int):
         one_plus = inner_gap * (radius + l + 2 * a) / (4 * a * radius)
         theta = 2.0 * np.arctan2(np.sqrt(np.maximum(one_minus, 0.0)),
                                  np.sqrt(np.maximum(one_plus, 0.0)))
-        sign = np.where(v < v_min, sense, -sense)
+        sign = np.where(w < w_min, sense, -sense)
         sigma = sign * theta
         delta = np.arctan2(-radius * np.sin(sigma), radius * np.cos(sigma) - 2 * a)
-        phi1 = alpha + sigma + np.where(v < v_min, 0.0, TWO_PI * sense)
+        phi1 = (alpha + sigma + np.where(w < w_min, 0.0, TWO_PI * sense)
+                - np.where(earlier, TWO_PI * sense, 0.0))
         cosine = np.where(one_minus < 0.0, 1.0 - one_minus, np.where(one_plus < 0.0,
                                                                      one_plus - 1.0, 0.0))
         return phi1, alpha + sigma + delta, cosine
 
-    return angles, v_min
+    return angles, float(linkage.u_min)
+
+
+def _cosine_of(curve, linkage, v):
+    """``c = (R^2 + 4a^2 - l^2) / (4 a R)`` at curve parameters ``v``: +-1 at the dead centres."""
+    radius = np.linalg.norm(curve(v) - np.asarray(linkage.centre), axis=-1)
+    a, l = linkage.a, linkage.l
+    return (radius**2 + 4 * a * a - l * l) / (4 * a * radius)
 
 
 def _reach_problems(curve, linkage, angles, path):
-    v = np.linspace(0.0, curve.period, 20 * len(curve.knots) * curve.samples_per_span,
-                    endpoint=False)
+    # as dense as ever for a drawn loop (20 x 64 a span); a digitised one has short spans
+    count = max(20 * 13 * 64, 16 * len(curve.knots) * curve.samples_per_span)
+    v = np.linspace(0.0, curve.period, count, endpoint=False)
     cosine = angles(v)[2]
     bad = np.abs(cosine) > 1.0 + REACH_TOL
     if not bad.any():
         return []
-    where = sorted({curve.describe(linkage.u_max + s) for s in v[bad]})
+    where = sorted({curve.describe(s) for s in v[bad]})
     kind = "centre distance a and reach l" if not linkage.derived else "linkage"
     return [Problem(path, "unreachable_points",
                     f"the loop leaves the annulus l - 2a <= R <= l + 2a that the tip can reach "
@@ -233,6 +348,13 @@ def _reach_problems(curve, linkage, angles, path):
                     f"{', '.join(where)}: the {kind} must follow from the curve "
                     f"(a = {(linkage.radius_max - linkage.radius_min) / 4:.4f}, "
                     f"l = {(linkage.radius_max + linkage.radius_min) / 2:.4f} mm)")]
+
+
+def _piece_samples(breaks, per_piece: int) -> np.ndarray:
+    """``per_piece`` evenly spaced samples on every piece, both ends included."""
+    local = np.linspace(0.0, 1.0, per_piece + 1)[:-1]
+    inner = (breaks[:-1, None] + np.diff(breaks)[:, None] * local).ravel()
+    return np.append(inner, breaks[-1])
 
 
 def carrier_motion(curve: ClosedCurve, linkage: Linkage, *, path: str = "trajectory.points",
@@ -255,15 +377,14 @@ def carrier_motion(curve: ClosedCurve, linkage: Linkage, *, path: str = "traject
     accepted = []
     for mode in (1, -1):
         angles, v_min = _mode_functions(curve, linkage, mode)
-        problems = _reach_problems(curve, linkage, angles, path)
-        if problems:
+        problems = _reach_problems(curve, linkage, angles, path) if mode == 1 else []
+        if problems:   # the annulus does not depend on the mode: checked once
             raise DesignError(problems)
         # the branch switch is continuous only where the tip really reaches l +- 2a
         tiny = 1e-9 * curve.period
-        jump = max(abs(float(angles(np.array([v_min - tiny]))[0][0]
-                             - angles(np.array([v_min + tiny]))[0][0])),
-                   abs(float(angles(np.array([curve.period - tiny]))[0][0]
-                             - angles(np.array([tiny]))[0][0]) - TWO_PI * mode))
+        jump = max(abs(float(angles(np.array([dead - tiny]))[0][0]
+                             - angles(np.array([dead + tiny]))[0][0]))
+                   for dead in (v_min, linkage.u_max))
         if jump > 1e-5:
             raise DesignError.single(
                 path if linkage.derived else "linkage", "dead_centre_mismatch",
@@ -273,41 +394,44 @@ def carrier_motion(curve: ClosedCurve, linkage: Linkage, *, path: str = "traject
                 "linkage would have to snap between its assembly modes; derive a and l from "
                 f"the curve (a = {(linkage.radius_max - linkage.radius_min) / 4:.4f}, "
                 f"l = {(linkage.radius_max + linkage.radius_min) / 2:.4f} mm)")
-        knots_v = np.mod(curve.knots[:-1] - linkage.u_max, curve.period)
-        breaks = np.unique(np.concatenate([[0.0, v_min, curve.period], knots_v]))
-        breaks = breaks[np.concatenate([[True], np.diff(breaks) > 1e-9 * curve.period])]
+        # The angles are analytic across both dead centres (the branch switch turns the
+        # arccos's |dv| into dv), so only the knots break them. A break at a dead centre
+        # would leave a sliver between it and a nearby type-value point, on which the third
+        # derivative the gears' curvature needs is ill-conditioned (error ~ 1/width^3).
+        breaks = np.asarray(curve.knots, dtype=float)
         try:
             phi1 = PiecewiseChebyshev.interpolate(lambda v: angles(v)[0], breaks)
             phi2 = PiecewiseChebyshev.interpolate(lambda v: angles(v)[1], breaks)
         except ConvergenceError:
             # only a near-cusp of the angles does this: the tip nearly touches l +- 2a twice
             probe = np.linspace(0.0, curve.period, 20000, endpoint=False)
-            cosine = np.abs(angles(probe)[2])
-            near = np.flatnonzero((cosine > 1 - 1e-3) & (np.abs(np.mod(probe - v_min + 0.5 *
-                                   curve.period, curve.period) - 0.5 * curve.period) > 0.02 *
-                                   curve.period) & (np.minimum(probe, curve.period - probe)
-                                                    > 0.02 * curve.period))
-            where = sorted({curve.describe(linkage.u_max + s) for s in probe[near]}) or ["?"]
+            cosine = np.abs(_cosine_of(curve, linkage, probe))
+            away = np.ones(probe.shape, dtype=bool)
+            for dead in (v_min, linkage.u_max):
+                away &= np.abs(np.mod(probe - dead + 0.5 * curve.period, curve.period)
+                               - 0.5 * curve.period) > 0.02 * curve.period
+            near = np.flatnonzero((cosine > 1 - 1e-3) & away)
+            where = sorted({curve.describe(s) for s in probe[near]}) or ["?"]
             raise DesignError.single(
                 path, "near_dead_centre",
                 f"the loop comes back almost to a dead-centre radius (l +- 2a) near "
                 f"{', '.join(where)}: the carrier would have to turn almost instantly there; "
                 "round off the loop there") from None
         rate1, rate2 = phi1.derivative(), phi2.derivative()
-        probe = np.linspace(0.0, curve.period, 40 * len(curve.knots) * 16)
+        probe = _piece_samples(rate1.breaks, max(64, -(-8320 // (len(rate1.breaks) - 1))))
         slope = mode * rate1(probe)
         turn = float(phi1(curve.period) - phi1(0.0))
         needle_turn = float(phi2(curve.period) - phi2(0.0))
         monotone = bool(slope.min() > 0.0)
         full = abs(turn - TWO_PI * mode) < 1e-6
         closed = abs(needle_turn) < 1e-6
-        reversals = sorted({curve.describe(linkage.u_max + s) for s in probe[slope <= 0.0]})
+        reversals = sorted({curve.describe(s) for s in probe[slope <= 0.0]})
         reports[mode] = {"monotone": monotone, "carrier_turn_deg": float(np.degrees(turn)),
                          "needle_turn_deg": float(np.degrees(needle_turn)),
                          "reverses_near": reversals[:6]}
         if monotone and full and closed:
-            accepted.append(CarrierMotion(curve, linkage, mode, v_min, breaks,
-                                          phi1, phi2, rate1, rate2))
+            accepted.append(CarrierMotion(curve, linkage, mode, v_min, float(linkage.u_max),
+                                          breaks, phi1, phi2, rate1, rate2))
     if not accepted:
         where = "; ".join(f"mode {'+' if s > 0 else '-'}: carrier reverses near "
                           f"{', '.join(r['reverses_near']) or 'nowhere'}"
@@ -404,7 +528,10 @@ class _StageGeometry:
     def __init__(self, motion: CarrierMotion, samples_per_piece: int = 48):
         self.motion = motion
         self.a = motion.linkage.a
-        self.ratio = PiecewiseChebyshev.interpolate(motion.ratio, motion.breaks)
+        # the rates are polynomials on the pieces of their own fits: the ratio is smooth
+        # only between the union of those breaks, so it is fitted on that union
+        breaks = np.union1d(motion.phi1_rate.breaks, motion.phi2_rate.breaks)
+        self.ratio = PiecewiseChebyshev.interpolate(motion.ratio, breaks)
         self.ratio_rate = self.ratio.derivative()
         self.ratio_rate2 = self.ratio_rate.derivative()
         self.turn_rate = motion.phi1_rate            # dphi1/dv, sign = sense
@@ -412,9 +539,24 @@ class _StageGeometry:
         breaks = self.ratio.breaks
         local = (np.arange(samples_per_piece) + 0.5) / samples_per_piece
         self.samples = (breaks[:-1, None] + np.diff(breaks)[:, None] * local).ravel()
+        self._memo = {}
+
+    def _terms(self, v):
+        """``(i, i', i'', phi1', phi1'')`` at ``v``, memoised: the perimeter and exponent
+        searches fit on the ratio's own nodes again and again."""
+        v = np.asarray(v, dtype=float)
+        key = (v.shape, hash(v.tobytes()))
+        terms = self._memo.get(key)
+        if terms is None:
+            terms = (self.ratio(v), self.ratio_rate(v), self.ratio_rate2(v),
+                     self.turn_rate(v), self.turn_rate2(v))
+            if len(self._memo) > 16:
+                self._memo.clear()
+            self._memo[key] = terms
+        return terms
 
     def ratio_terms(self, v):
-        return self.ratio(v), self.ratio_rate(v), self.ratio_rate2(v)
+        return self._terms(v)[:3]
 
     def stage_ratio(self, v, constant, exponent):
         return _power_ratio(*self.ratio_terms(v), constant, exponent)
@@ -423,7 +565,7 @@ class _StageGeometry:
         """``integral i^w dphi1`` over one turn (magnitude)."""
         sense = self.motion.sense
         return PiecewiseChebyshev.interpolate(
-            lambda v: _positive(self.ratio(v)) ** exponent * sense * self.turn_rate(v),
+            lambda v: _positive(self._terms(v)[0]) ** exponent * sense * self._terms(v)[3],
             self.ratio.breaks).integral()
 
     def gear_curve(self, v, constant, exponent, role, angle_factor):
@@ -441,8 +583,9 @@ class _StageGeometry:
         else:
             rho, d_rho, dd_rho = self.a - drive, -d_drive, -dd_drive
         factor, d_factor = angle_factor(v)
-        psi_rate = factor * self.turn_rate(v)
-        psi_rate2 = d_factor * self.turn_rate(v) + factor * self.turn_rate2(v)
+        _, _, _, turn_rate, turn_rate2 = self._terms(v)
+        psi_rate = factor * turn_rate
+        psi_rate2 = d_factor * turn_rate + factor * turn_rate2
         return rho, d_rho, dd_rho, psi_rate, psi_rate2
 
     def perimeter(self, constant, exponent, role, angle_factor):
@@ -495,19 +638,34 @@ def equal_perimeter_exponent(geometry: _StageGeometry) -> float:
     return float(brentq(difference, low, high, xtol=1e-12))
 
 
+#: Concave runs closer than this in carrier progress are one stretch for the designer (deg).
+STRETCH_MERGE_DEG = 1.0
+
+
 def _stretches(v, mask, geometry, curve, motion):
-    """Contiguous runs of ``mask`` over the samples, in carrier progress (deg) and type-value points."""
-    runs = []
+    """Runs of ``mask`` over the samples, in carrier progress (deg) from the Rmax dead centre.
+
+    Runs less than :data:`STRETCH_MERGE_DEG` apart are merged, so a curvature that
+    grazes zero reads as one stretch, not a hundred one-sample ones.
+    """
     if not mask.any():
-        return runs
+        return []
+    progress = np.degrees(motion.progress(v))
+    order = np.argsort(progress)
+    progress, mask, v = progress[order], mask[order], v[order]
     edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-    progress = np.degrees(motion.sense * (motion.phi1(v) - motion.phi1(0.0)))
+    merged = []
     for start, stop in zip(edges[::2], edges[1::2]):
-        first = curve.describe(motion.linkage.u_max + v[start])
-        last = curve.describe(motion.linkage.u_max + v[stop - 1])
+        if merged and progress[start] - progress[merged[-1][1] - 1] < STRETCH_MERGE_DEG:
+            merged[-1][1] = stop
+        else:
+            merged.append([start, stop])
+    runs = []
+    for start, stop in merged:
+        first, last = curve.describe(motion.u(v[start])), curve.describe(motion.u(v[stop - 1]))
         runs.append({"carrier_deg": [float(progress[start]), float(progress[stop - 1])],
                      "near": first if first == last else f"{first} to {last}",
-                     "samples": int(stop - start)})
+                     "samples": int(mask[start:stop].sum())})
     return runs
 
 
@@ -569,11 +727,44 @@ class PrickingDesign:
     def carrier_sense(self) -> str:
         return "counter-clockwise" if self.motion.sense > 0 else "clockwise"
 
+    def cycle_functions(self):
+        """Each gear's contact functions over the carrier cycle ``tau`` from the Rmax dead centre.
+
+        ``tau = v - v_max`` (mod the period): the train, its sheet and the assembly start
+        at the outer dead centre whichever type-value point the loop starts from. Each
+        contact angle stays continuous across the loop's start (it gains its whole turn
+        there). Returns ``({name: tau -> (rho, drho, psi, dpsi)}, breaks)``.
+        """
+        motion = self.motion
+        shift, period = motion.v_max, motion.period
+
+        def from_dead_centre(function):
+            ends = np.array([0.0, period])
+            turn = float(np.diff(function(ends)[2])[0])
+
+            def shifted(tau):
+                v = np.mod(np.asarray(tau, dtype=float), period) + shift
+                wrapped = v >= period
+                rho, d_rho, psi, d_psi = function(np.where(wrapped, v - period, v))
+                return rho, d_rho, psi + np.where(wrapped, turn, 0.0), d_psi
+            return shifted
+
+        breaks = np.unique(np.concatenate([[0.0, period], motion.cycle(motion.breaks)]))
+        functions = {name: from_dead_centre(f) for name, f in self.pitch_functions.items()}
+        return functions, tuple(breaks[np.concatenate([[True], np.diff(breaks) > 0.0])])
+
 
 def _integral_function(geometry, rate):
-    """Antiderivative along v of ``rate(v) * dphi1/dv`` (signed like phi1)."""
-    return PiecewiseChebyshev.interpolate(lambda v: rate(v) * geometry.turn_rate(v),
-                                          geometry.ratio.breaks).antiderivative()
+    """Antiderivative along v of ``rate(v) * dphi1/dv`` (signed like phi1), zero at the Rmax dead centre.
+
+    The gears' body frames are fixed by where this is zero: at the Rmax dead centre,
+    whichever type-value point the loop starts from.
+    """
+    integral = PiecewiseChebyshev.interpolate(lambda v: rate(v) * geometry.turn_rate(v),
+                                              geometry.ratio.breaks).antiderivative()
+    coefficients = integral.coefficients.copy()
+    coefficients[:, 0] -= float(integral(geometry.motion.v_max))
+    return PiecewiseChebyshev(integral.breaks, coefficients)
 
 
 def _forward_check(motion, grid_phi1, grid_v, radii):
@@ -627,9 +818,26 @@ def _ratio_extreme(geometry: _StageGeometry, sign: float = 1.0, per_piece: int =
     return best_v, sign * best
 
 
-def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pressure_angle,
-                 addendum, min_ratio, grid, sense):
+def _stage_one_perimeter(points, *, degree, centre, rocker, a, l, exponent, min_ratio, sense,
+                         **_):
+    """Stage 1's pitch perimeter and the split exponent, without the gears' reports.
+
+    All the first pass of :func:`design_pricking` needs to choose the scale: scaling
+    about O keeps every angle, hence the ratio law and its split.
+    """
+    _, _, _, _, geometry, w, constant, _, _ = _motion_and_split(
+        points, degree=degree, centre=centre, rocker=rocker, a=a, l=l, exponent=exponent,
+        min_ratio=min_ratio, sense=sense)
+    sun = _angle_factors(geometry, constant, w)[0]
+    return geometry.perimeter(constant, w, "drive", sun), w
+
+
+def _motion_and_split(points, *, degree, centre, rocker, a, l, exponent, min_ratio, sense):
+    """Curve, linkage, carrier motion, the ratio's extremes and its split into two stages."""
     curve = ClosedCurve(points, degree)
+    problems = travel_direction_problems(curve)
+    if problems:
+        raise DesignError(problems)
     linkage = link_lengths(curve, centre, rocker, a=a, l=l)
     motion, modes = carrier_motion(curve, linkage, sense=sense)
     geometry = _StageGeometry(motion)
@@ -638,16 +846,25 @@ def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pres
         raise DesignError.single(
             "trajectory.points", "ratio_not_positive",
             f"the planet's ratio to the carrier i = 1 - dphi2/dphi1 falls to {lowest_ratio:.4f} "
-            f"(must stay above {min_ratio:g}) near {curve.describe(linkage.u_max + lowest_v)}: "
+            f"(must stay above {min_ratio:g}) near {curve.describe(lowest_v)}: "
             "the needle would have to turn back faster than the carrier; spread the points of "
             "the pricking segment")
     highest_ratio = _ratio_extreme(geometry, -1.0)[1]
     w = equal_perimeter_exponent(geometry) if exponent == EQUAL_PERIMETER else float(exponent)
     constant = TWO_PI / geometry.exponent_integral(w)
+    return curve, linkage, motion, modes, geometry, w, constant, lowest_ratio, highest_ratio
+
+
+def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pressure_angle,
+                 addendum, min_ratio, grid, sense):
+    (curve, linkage, motion, modes, geometry, w, constant, lowest_ratio,
+     highest_ratio) = _motion_and_split(points, degree=degree, centre=centre, rocker=rocker,
+                                        a=a, l=l, exponent=exponent, min_ratio=min_ratio,
+                                        sense=sense)
     sun, int1, int2, planet = _angle_factors(geometry, constant, w)
 
     sense = motion.sense
-    phi1_start = float(motion.phi1(0.0))
+    phi1_start = motion.phi1_start
     grid_phi1 = phi1_start + sense * (np.arange(grid) + 0.5) * (TWO_PI / grid)
     grid_v = motion.invert(grid_phi1)
     common = dict(module=module, pressure_angle=pressure_angle, addendum=addendum)
@@ -671,8 +888,8 @@ def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pres
         gear.table["carrier_angle"] = grid_phi1
     pitch_functions = _pitch_functions(geometry, constant, w, (sun, int1, int2, planet),
                                        stage1_turn, total_turn)
-    stage_closure = [abs(stage1_turn(curve.period) * sense - TWO_PI),
-                     abs(total_turn(curve.period) * sense - TWO_PI)]
+    stage_closure = [abs((stage1_turn(curve.period) - stage1_turn(0.0)) * sense - TWO_PI),
+                     abs((total_turn(curve.period) - total_turn(0.0)) * sense - TWO_PI)]
     stages = []
     for index, (drive, driven, c, e) in enumerate(
             ((gears["sun"], gears["intermediate 1"], constant, w),
@@ -707,9 +924,12 @@ def _pitch_functions(geometry, constant, exponent, factors, stage1_turn, total_t
                    lambda v: np.pi + total_turn(v)),
     }
 
+    period = geometry.motion.period
+
     def make(c, e, role, factor, angle):
         def functions(v):
-            v = np.mod(np.asarray(v, dtype=float), geometry.motion.period)
+            v = np.asarray(v, dtype=float)
+            v = np.where((v < 0.0) | (v > period), np.mod(v, period), v)
             rho, d_rho, _, psi_rate, _ = geometry.gear_curve(v, c, e, role, factor)
             return rho, d_rho, angle(v), psi_rate
         return functions
@@ -717,14 +937,18 @@ def _pitch_functions(geometry, constant, exponent, factors, stage1_turn, total_t
     return {name: make(*spec) for name, spec in specs.items()}
 
 
+def _stretch_text(stretch) -> str:
+    low, high = stretch["carrier_deg"]
+    span = (f"{low:.1f} deg" if f"{low:.1f}" == f"{high:.1f}" else f"{low:.1f} to {high:.1f} deg")
+    return f"carrier progress {span} (tip near {stretch['near']})"
+
+
 def _findings(stages, curve):
     notes = []
     for stage in stages:
         for gear in (stage.drive, stage.driven):
             if not gear.convex:
-                where = "; ".join(f"carrier progress {s['carrier_deg'][0]:.1f} to "
-                                  f"{s['carrier_deg'][1]:.1f} deg (tip near {s['near']})"
-                                  for s in gear.concave_stretches)
+                where = "; ".join(_stretch_text(s) for s in gear.concave_stretches)
                 advice = ("use the degree-5 curve, or move the type-value points there onto a "
                           "smoother loop" if curve.degree == 3 else
                           "move the type-value points there onto a smoother loop")
@@ -744,46 +968,99 @@ def _findings(stages, curve):
     return notes
 
 
+def _module_problem(perimeter, module, teeth, scale, min_teeth, max_scale_change) -> Problem:
+    """``module_does_not_fit``, with the modules that give whole teeth at the drawn size."""
+    exact = perimeter / (np.pi * module)
+    counts = [n for n in range(max(min_teeth, int(exact) - 1), max(min_teeth, int(exact) - 1) + 4)]
+    fits = ", ".join(f"{perimeter / (np.pi * n):.4g} mm ({n} teeth)" for n in counts)
+    return Problem(
+        "gears.module", "module_does_not_fit",
+        f"at module {module:g} mm stage 1's pitch perimeter ({perimeter:.2f} mm at the drawn size) "
+        f"holds {exact:.2f} teeth; {teeth} whole teeth would scale the whole design, drawn loop "
+        f"included, by {scale:.4g}, beyond the {max_scale_change:.0%} allowed "
+        f"(gears.max_scale_change): modules that fit the drawn size: {fits}")
+
+
 def design_pricking(points, *, rocker: float, degree: int = 3, centre=(0.0, 0.0),
                     a: float | None = None, l: float | None = None,
                     exponent=EQUAL_PERIMETER, module: float = 2.0,
                     pressure_angle: float = np.radians(20.0), addendum: float = 1.0,
                     min_ratio: float = 0.05, grid: int = 720, min_teeth: int = 8,
-                    sense: int | None = None) -> PrickingDesign:
+                    sense: int | None = None,
+                    max_scale_change: float = 0.05) -> PrickingDesign:
     """Inverse design of the pricking mechanism from the type-value points of its tip loop.
 
     The design is scaled about the sun centre so that stage 1 holds a whole
     number of teeth at ``module``; stage 2 then takes the nearest whole number
     and its own module (equal to ``module`` with the equal-perimeter split).
+    The scale may differ from 1 by at most ``max_scale_change`` (the drawn loop
+    is the designer's; rounding to whole teeth is meant to move it slightly):
+    beyond that, ``module_does_not_fit`` names the modules that would.
 
     Raises
     ------
     DesignError
         With a specific code: ``coincident_points``, ``self_intersecting_curve``,
         ``origin_inside_loop``, ``rocker_too_long``, ``unreachable_points``,
-        ``no_assembly_mode``, ``ratio_not_positive``.
+        ``no_assembly_mode``, ``ratio_not_positive``, ``loop_runs_forward``,
+        ``module_does_not_fit``, ``fit_not_converged``.
     """
     points = np.asarray(points, dtype=float)
     centre = np.asarray(centre, dtype=float)
     options = dict(degree=degree, centre=centre, rocker=rocker, a=a, l=l, exponent=exponent,
                    module=module, pressure_angle=pressure_angle, addendum=addendum,
                    min_ratio=min_ratio, grid=grid, sense=sense)
-    first = _design_once(points, **options)
-    perimeter = first[5][0].perimeter
+    perimeter, split = _checked_design(points, options, _stage_one_perimeter)
     # scaling about O leaves every angle, hence the ratio law and its split, unchanged
-    options["exponent"] = first[4]
+    options["exponent"] = split
     teeth_1 = max(min_teeth, int(round(perimeter / (np.pi * module))))
     scale = teeth_1 * np.pi * module / perimeter
+    if abs(scale - 1.0) > max_scale_change:
+        raise DesignError([_module_problem(perimeter, module, teeth_1, scale, min_teeth,
+                                           max_scale_change)])
     if a is not None:
         options["a"] = a * scale
     if l is not None:
         options["l"] = l * scale
     options["rocker"] = rocker * scale
-    result = _design_once(centre + scale * (points - centre), **options)
+    result = _checked_design(centre + scale * (points - centre), options)
     (curve, linkage, motion, modes, w, stages, grid_tables, deviation, closure, i_min, i_max,
      functions) = result
     teeth_2 = max(min_teeth, int(round(stages[1].perimeter / (np.pi * module))))
     modules = (stages[0].perimeter / (np.pi * teeth_1), stages[1].perimeter / (np.pi * teeth_2))
+    findings = _findings(stages, curve) + _forward_findings(deviation, grid)
     return PrickingDesign(curve, linkage, motion, modes, w, stages, float(scale),
                           (teeth_1, teeth_2), modules, grid_tables, deviation, abs(closure),
-                          i_min, i_max, _findings(stages, curve), functions)
+                          i_min, i_max, findings, functions)
+
+
+def _checked_design(points, options, stage=None):
+    """:func:`_design_once` (or another pass), an unconverged fit turned into a design error."""
+    from .chebyshev import UnconvergedFit
+
+    try:
+        return (stage or _design_once)(points, **options)
+    except UnconvergedFit as error:
+        curve = ClosedCurve(points, options["degree"])
+        where = sorted({curve.describe(0.5 * (low + high)) for low, high in error.intervals})
+        raise DesignError.single(
+            "trajectory.points", "fit_not_converged",
+            f"the carrier and needle motion could not be resolved to its tolerance near "
+            f"{', '.join(where[:4])} ({error}): the loop has a kink or a near-cusp there that "
+            "the linkage cannot follow smoothly; move the type-value points there onto a "
+            "smoother loop") from None
+
+
+def _forward_findings(deviation: float, grid: int) -> list:
+    """The tabulated pitch curves must reproduce the loop; if not, the grid that would."""
+    if deviation <= FORWARD_TOLERANCE:
+        return []
+    # the periodic cubic spline through the tables errs as (step)^4: aim at half the tolerance
+    needed = grid * (deviation / (0.5 * FORWARD_TOLERANCE)) ** 0.25
+    suggestion = int(np.ceil(needed / 360.0) * 360)
+    return [Problem(
+        "resolution.inverse_grid", "forward_check_deviation",
+        f"the tip loop rebuilt from the pitch curves tabulated at {grid} carrier steps strays "
+        f"{deviation:.3g} mm from the designed loop (tolerance {FORWARD_TOLERANCE:g} mm): the "
+        f"ratio changes too fast for that grid; set resolution.inverse_grid to about "
+        f"{suggestion}")]

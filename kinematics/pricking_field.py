@@ -87,7 +87,7 @@ class _FieldModel:
         self.omega = TWO_PI * carrier_speed_rpm / 60.0
         self.speed = forward_speed
         self.needle = needle_geometry(design)
-        self.start = float(self.motion.phi1(0.0))
+        self.start = self.motion.phi1_start
 
     def _wrap(self, v):
         v = np.asarray(v, dtype=float)

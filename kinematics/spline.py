@@ -27,21 +27,35 @@ __all__ = ["ClosedCurve", "winding_number", "self_intersections"]
 
 #: Smallest chord, as a fraction of the mean chord, before two points count as coincident.
 COINCIDENT_CHORD_RATIO = 1e-3
+#: Samples of the whole loop for its dense checks, shared among the spans (8 to 64 each).
+DENSE_SAMPLES = 8192
 
 
 def self_intersections(polygon: np.ndarray) -> np.ndarray:
-    """Index pairs ``(i, j)`` of non-adjacent edges of a closed polygon that cross.
+    """Index pairs ``(i, j)``, ``i < j``, of non-adjacent edges of a closed polygon that cross.
+
+    Near-linear in the number of edges: two edges can cross only if their
+    midpoints are within the sum of their half-lengths, so a KD-tree on the
+    midpoints proposes the candidate pairs (a digitised loop has thousands of
+    edges; all pairs would take gigabytes).
 
     Parameters
     ----------
     polygon : (n, 2) float
         Vertices, not repeating the first at the end.
     """
+    from scipy.spatial import cKDTree
+
     start = np.asarray(polygon, dtype=float)
     end = np.roll(start, -1, axis=0)
     n = len(start)
-    i, j = np.triu_indices(n, k=2)
-    keep = ~((i == 0) & (j == n - 1))  # the closing edge touches the first
+    middle = 0.5 * (start + end)
+    reach = float(np.linalg.norm(end - start, axis=1).max())
+    pairs = cKDTree(middle).query_pairs(reach * (1 + 1e-9), output_type="ndarray")
+    if pairs.size == 0:
+        return np.zeros((0, 2), dtype=int)
+    i, j = pairs.min(axis=1), pairs.max(axis=1)
+    keep = (j - i >= 2) & ~((i == 0) & (j == n - 1))  # neighbours share a vertex
     i, j = i[keep], j[keep]
     p0, p1, q0, q1 = start[i], end[i], start[j], end[j]
     d1 = _cross(p1 - p0, q0 - p0)
@@ -49,7 +63,8 @@ def self_intersections(polygon: np.ndarray) -> np.ndarray:
     d3 = _cross(q1 - q0, p0 - q0)
     d4 = _cross(q1 - q0, p1 - q0)
     hit = (d1 * d2 < 0) & (d3 * d4 < 0)
-    return np.stack([i[hit], j[hit]], axis=-1)
+    order = np.lexsort((j[hit], i[hit]))
+    return np.stack([i[hit][order], j[hit][order]], axis=-1)
 
 
 def winding_number(polygon: np.ndarray, point) -> int:
@@ -84,7 +99,7 @@ class ClosedCurve:
     points: np.ndarray
     degree: int = 3
     path: str = "trajectory.points"
-    samples_per_span: int = 64
+    samples_per_span: int | None = None
     _spline: object = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -98,6 +113,11 @@ class ClosedCurve:
                                      f"{len(points)} points are too few for a closed curve of "
                                      f"degree {self.degree} (at least {self.degree + 2})")
         object.__setattr__(self, "points", points)
+        if self.samples_per_span is None:
+            # 64 a span for a drawn loop of a dozen points; a digitised loop of thousands has
+            # short spans, and about 8192 samples in all still resolve every one of them
+            object.__setattr__(self, "samples_per_span",
+                               int(np.clip(DENSE_SAMPLES // len(points), 8, 64)))
         chords = np.linalg.norm(np.roll(points, -1, axis=0) - points, axis=1)
         tiny = np.flatnonzero(chords < COINCIDENT_CHORD_RATIO * chords.mean())
         if tiny.size:

@@ -10,10 +10,18 @@ in one vectorized call per level) until every interval's bound is within
 ``atol`` of the best value. The result carries the minimum, where it occurs,
 and the certified lower bound: the true minimum lies in ``[bound, value]``.
 
-Where a bound ``K`` on ``|f''|`` is known the screen is second order,
+Where a bound ``K`` on ``f''`` is known the screen is second order,
 ``f >= min(f_i, f_i+1) - K h^2 / 8``, which also holds for a pointwise minimum of
 such functions (a distance between polylines). Near a smooth minimum this
-leaves a handful of intervals to refine instead of dozens.
+leaves a handful of intervals to refine instead of dozens. A caller may add a
+bound of its own (``interval_bound``), and a known ``floor`` (a distance is never
+negative): a value found on the floor is the minimum, certified at once.
+
+The work is bounded (``max_evaluations``): a search that spends its budget
+returns what it reached, ``certified = False`` and the gap ``[bound, value]``.
+Why a budget, not a finer tolerance: where two bodies touch or cross, a
+distance has a kink (its curvature is unbounded), so only the first-order bound
+holds there and closing it to ``atol`` would need intervals ``2 atol / L`` wide.
 """
 
 from __future__ import annotations
@@ -25,7 +33,15 @@ from .scalar import minimize_scalar
 
 from . import tolerances as tol
 
-__all__ = ["CertifiedMinimum", "certified_minimum"]
+__all__ = ["CertifiedMinimum", "certified_minimum", "Verdict"]
+
+
+class Verdict:
+    """Outcomes of comparing a searched minimum with a target (closed choice)."""
+
+    PASS = "pass"
+    FAIL = "fail"
+    UNDECIDED = "undecided"
 
 
 @dataclass(frozen=True)
@@ -44,6 +60,10 @@ class CertifiedMinimum:
         Intervals refined by Brent or split by branch and bound.
     evaluations : int
         Function evaluations in all (samples plus refinement).
+    atol : float
+        The tolerance the search was asked for.
+    budget_spent : bool
+        True when the search stopped at ``max_evaluations`` (see ``gap``).
     """
 
     value: float
@@ -52,22 +72,47 @@ class CertifiedMinimum:
     refined_intervals: int
     evaluations: int
     atol: float = 0.0
+    budget_spent: bool = False
 
     @property
     def certified(self) -> bool:
         """True when the bound is within ``atol`` of the value (the search finished)."""
         return self.value - self.bound <= self.atol * (1.0 + 1e-9)
 
+    @property
+    def gap(self) -> float:
+        """``value - bound``: the true minimum lies in ``[bound, value]``."""
+        return self.value - self.bound
 
-def _interval_bounds(f_left, f_right, width, lipschitz, curvature):
+    def verdict_above(self, target: float) -> str:
+        """Whether the true minimum is above ``target`` (:class:`Verdict`).
+
+        ``fail`` when the value found is not above it (the true minimum is no
+        larger); ``pass`` when the certified bound is above it, or when the search
+        certified (value within ``atol``) and the value is above it; otherwise
+        ``undecided``: the gap ``[bound, value]`` straddles the target.
+        """
+        if not self.value > target:
+            return Verdict.FAIL
+        if self.bound > target or self.certified:
+            return Verdict.PASS
+        return Verdict.UNDECIDED
+
+
+def _interval_bounds(f_left, f_right, width, lipschitz, curvature, interval_bound=None,
+                     floor=-np.inf):
     bounds = 0.5 * (f_left + f_right - lipschitz * width)
+    if interval_bound is not None:
+        with np.errstate(invalid="ignore"):
+            own = np.asarray(interval_bound(f_left, f_right, width), dtype=float)
+        bounds = np.where(np.isfinite(own), np.maximum(bounds, own), bounds)
     if curvature is not None:
         bend = curvature(bounds) if callable(curvature) else curvature
         bend = np.broadcast_to(np.asarray(bend, dtype=float), bounds.shape)
         with np.errstate(invalid="ignore"):
             second = np.minimum(f_left, f_right) - bend * width**2 / 8.0
         bounds = np.where(np.isfinite(second), np.maximum(bounds, second), bounds)
-    return bounds
+    return np.maximum(bounds, floor)
 
 
 def _finite(values, arguments):
@@ -80,8 +125,9 @@ def _finite(values, arguments):
 
 def certified_minimum(function, lower: float, upper: float, *, steps: int,
                       lipschitz: float, curvature=None, atol: float = 1e-9,
-                      xatol: float = tol.REFINE_XATOL,
-                      max_evaluations: int = 2_000_000) -> CertifiedMinimum:
+                      xatol: float = tol.REFINE_XATOL, floor: float | None = None,
+                      interval_bound=None,
+                      max_evaluations: int = tol.MINIMUM_SEARCH_EVALUATIONS) -> CertifiedMinimum:
     """Certified minimum of a continuous ``function`` on ``[lower, upper]``.
 
     Parameters
@@ -103,9 +149,15 @@ def certified_minimum(function, lower: float, upper: float, *, steps: int,
         the best value: the true minimum is then within ``atol`` of ``value``.
     xatol : float
         Absolute tolerance of the Brent refinement (rad).
+    floor : float, optional
+        A value the function never goes below (0 for a distance). Bounds are
+        never lower; a value on the floor is the certified minimum.
+    interval_bound : callable, optional
+        ``(f_left, f_right, width) -> (n,) float``: a further valid lower bound
+        of the function on each interval (combined with the others by ``max``).
     max_evaluations : int
-        Budget; when spent the result says ``certified = False`` and carries
-        the bound actually reached.
+        Budget; when spent the result says ``certified = False`` (and
+        ``budget_spent``) and carries the bound actually reached.
     """
     if not upper > lower:
         raise ValueError(f"upper must exceed lower, got [{lower}, {upper}]")
@@ -115,12 +167,18 @@ def certified_minimum(function, lower: float, upper: float, *, steps: int,
         raise ValueError(f"lipschitz must be a finite non-negative bound, not {lipschitz}")
     if not atol > 0:
         raise ValueError(f"atol must be positive, not {atol}")
+    floor = -np.inf if floor is None else float(floor)
+
+    def interval_bounds(f_left, f_right, width):
+        return _interval_bounds(f_left, f_right, width, lipschitz, curvature, interval_bound,
+                                floor)
+
     grid = np.linspace(lower, upper, steps + 1)
     with np.errstate(all="ignore"):
         values = _finite(function(grid), grid)
     left, right = grid[:-1], grid[1:]
     f_left, f_right = values[:-1], values[1:]
-    bounds = _interval_bounds(f_left, f_right, right - left, lipschitz, curvature)
+    bounds = interval_bounds(f_left, f_right, right - left)
     best = int(values.argmin())
     value, argument = float(values[best]), float(grid[best])
     evaluations = grid.size
@@ -134,19 +192,24 @@ def certified_minimum(function, lower: float, upper: float, *, steps: int,
         if np.isfinite(result.fun) and result.fun < value:
             value, argument = float(result.fun), float(result.x)
 
-    # Brent first round the best sample: it reaches a smooth minimum fast, and the
-    # better value lets the bounds discard most intervals at once
-    polish(grid[max(best - 1, 0)], grid[min(best + 1, steps)])
-    refined += 1
+    if value > floor:
+        # Brent first round the best sample: it reaches a smooth minimum fast, and the
+        # better value lets the bounds discard most intervals at once
+        polish(grid[max(best - 1, 0)], grid[min(best + 1, steps)])
+        refined += 1
     # branch and bound on whatever could still undercut, one vectorized call per level
     retired = np.inf
     improved = False
+    spent = False
     while True:
         active = bounds < value - atol
         if (~active).any():
             retired = min(retired, float(bounds[~active].min()))
         left, right, f_left, f_right = left[active], right[active], f_left[active], f_right[active]
-        if left.size == 0 or evaluations + left.size > max_evaluations:
+        if left.size == 0:
+            break
+        if evaluations + left.size > max_evaluations:
+            spent = True
             break
         middle = 0.5 * (left + right)
         with np.errstate(all="ignore"):
@@ -159,9 +222,9 @@ def certified_minimum(function, lower: float, upper: float, *, steps: int,
             reach = right[k] - left[k]
         left, right = np.concatenate([left, middle]), np.concatenate([middle, right])
         f_left, f_right = np.concatenate([f_left, f_middle]), np.concatenate([f_middle, f_right])
-        bounds = _interval_bounds(f_left, f_right, right - left, lipschitz, curvature)
-    if improved:  # a new basin was found by splitting: polish its bottom
+        bounds = interval_bounds(f_left, f_right, right - left)
+    if improved and value > floor:  # a new basin was found by splitting: polish its bottom
         polish(max(lower, argument - reach), min(upper, argument + reach))
     open_bound = float(bounds.min()) if left.size else np.inf
-    bound = min(retired, open_bound, value)
-    return CertifiedMinimum(value, argument, bound, refined, evaluations, atol)
+    bound = min(max(min(retired, open_bound), floor), value)
+    return CertifiedMinimum(value, argument, bound, refined, evaluations, atol, spent)

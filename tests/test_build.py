@@ -208,3 +208,99 @@ def load_params_text(text):
     from cadgen.params import validate_text
 
     return validate_text(text)
+
+
+# ------------------------------------------------------------------ checks of a stage not run
+# planter.L2 = 150 mm: the duckbill linkage's push rod ends above the lever pin
+# (push_rod_inverted), a check of the cam stage; the kinematics and metrics do not need it.
+
+
+@pytest.fixture
+def short_planter(tmp_path):
+    path = tmp_path / "short-planter.toml"
+    path.write_text(edited(L2="150.0", name='"short-planter"'), encoding="utf-8")
+    return path
+
+
+def test_a_metrics_build_keeps_a_cam_check_as_a_warning_with_its_stage(short_planter, tmp_path,
+                                                                         capsys):
+    out = tmp_path / "out"
+    code = main(["build", str(short_planter), "--effects", "metrics", "--output-dir", str(out)])
+    assert code == EXIT_OK
+    report = json.loads((out / "short-planter" / "report.json").read_text(encoding="utf-8"))
+    assert [(w["path"], w["code"], w["stage"]) for w in report["warnings"]] == [
+        ("cam.lever.roller_arm", "push_rod_inverted", "cam")]
+    assert report["passed"] and [s["stage"] for s in report["stages"]] == ["kinematics",
+                                                                            "metrics"]
+    printed = capsys.readouterr().out
+    assert "warning: cam.lever.roller_arm:" in printed and "[push_rod_inverted] (stage cam" \
+        in printed
+
+
+def test_a_build_that_runs_the_cam_refuses_the_design_and_writes_nothing(short_planter,
+                                                                         tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["build", str(short_planter), "--output-dir", str(out)]) == 2
+    assert "push_rod_inverted" in capsys.readouterr().err
+    assert not (out / "short-planter").exists()
+
+
+def test_validate_reports_a_cam_check_as_a_warning_with_its_stage(short_planter, capsys):
+    assert main(["validate", str(short_planter)]) == EXIT_OK
+    lines = capsys.readouterr().out.splitlines()
+    assert any(line.startswith(f"{short_planter}: warning: cam.lever.roller_arm: ")
+               and line.endswith("[push_rod_inverted] (stage cam)") for line in lines), lines
+
+
+def test_the_library_loads_such_a_design_for_a_metrics_only_evaluation():
+    from cadgen.design import evaluate
+    from cadgen.params import stage_problems, validate_text
+
+    params = validate_text(edited(L2="150.0"))
+    assert [(p.code, p.stage) for p in stage_problems(params)] == [("push_rod_inverted", "cam")]
+    assert evaluate(params, steps=720).metrics   # the metrics evaluate
+    with pytest.raises(DesignError) as caught:   # ParameterError: a DesignError too
+        build(params, None, effects=["solids"])  # solids need the cam
+    assert [p.code for p in caught.value.problems] == ["push_rod_inverted"]
+
+
+# ------------------------------------------------------------------ "certified" is true
+
+
+def test_crossing_arms_report_a_certified_distance_of_zero(tmp_path):
+    report = build(load_params_text(edited(L1="250.0")), None, effects=["metrics"]).report
+    search = report["accuracy"]["minimum_searches"]["arm_distance"]
+    assert search["certified"] and search["value"] == search["certified_bound"] == 0.0
+    assert search["evaluations"] < 5_000
+    arm = next(m for m in report["metrics"] if m["key"] == "arm_distance")
+    assert (arm["passed"], arm["verdict"]) == (False, "fail")
+    (row,) = [r for r in report["accuracy_achieved"]
+              if r["knob"] == "resolution.steps_per_revolution"]
+    assert "NOT certified" not in row["achieved"] and "arm_distance" in row["achieved"]
+
+
+@pytest.mark.parametrize("target, verdict", [(10.0, "fail"), (1e-7, "undecided")])
+def test_a_search_that_did_not_certify_is_named_with_its_gap(monkeypatch, target, verdict):
+    # arms 0.14 nm apart at the closest, and a budget too small to close the bound there
+    from kinematics.clearance import KinematicClearance, arm_distance
+
+    monkeypatch.setattr(KinematicClearance, "arm_distance",
+                        lambda self, mechanism, steps: arm_distance(
+                            mechanism, steps=steps, max_evaluations=20_000))
+    params = load_params_text(edited(L1="242.640835", arm_distance_min=repr(target)))
+    report = build(params, None, effects=["metrics"]).report
+    search = report["accuracy"]["minimum_searches"]["arm_distance"]
+    assert not search["certified"] and search["budget_spent"]
+    assert search["certified_bound"] < target < search["value"] or verdict == "fail"
+    (row,) = [r for r in report["accuracy_achieved"]
+              if r["knob"] == "resolution.steps_per_revolution"]
+    achieved = row["achieved"]
+    assert "certified: lowest_point, highest_point, ground_clearance" in achieved
+    assert (f"NOT certified: arm_distance (budget of {search['evaluations']} evaluations "
+            f"spent), true minimum in [{search['certified_bound']:.9g}, {search['value']:.9g}]"
+            in achieved)
+    arm = next(m for m in report["metrics"] if m["key"] == "arm_distance")
+    assert (arm["passed"], arm["verdict"]) == (False, verdict)
+    assert not report["passed"]
+    if verdict == "undecided":
+        assert any("undecided" in f for f in report["failures"])

@@ -17,7 +17,8 @@ from scipy.optimize import brentq
 
 from cadgen.cam_design import design_cam
 from cadgen.design import build_mechanism, evaluate
-from cadgen.params import ParameterError, validate_text
+from cadgen.build import build
+from cadgen.params import ParameterError, stage_problems, validate_text
 from kinematics.duckbill import DuckbillLinkage
 from kinematics.errors import DesignError
 from kinematics.motion_laws import MOTION_LAWS, FollowerProgram
@@ -261,13 +262,23 @@ def test_roller_larger_than_the_smallest_convex_radius_is_reported(paper):
     (dict(closing_duration_deg="150.0"), "cam.timing.closing_duration_deg", "closes_too_late"),
     (dict(opening_duration_deg="120.0"), "cam.timing.opening_duration_deg", "phase_order"),
     (dict(pot_diameter="190.0"), "cam.pot_diameter", "mouth_narrower_than_pot"),
-    (dict(rise_law='"cycloid"'), "cam.rise_law", None),
-])
-def test_impossible_cam_files_name_the_field(changes, path, code):
+    (dict(L2="150.0"), "cam.lever.roller_arm", "push_rod_inverted"),
+], ids=["seedling", "closing", "opening", "pot", "push-rod"])
+def test_impossible_cam_files_name_the_field_in_the_cam_stage(changes, path, code):
+    # the file loads (a metrics-only evaluation may go on), the problem kept with its stage;
+    # a build that runs the cam refuses it before any stage runs
+    params = validate_text(edited(**changes))
+    found = {(p.path, p.code, p.stage) for p in stage_problems(params)}
+    assert (path, code, "cam") in found, found
     with pytest.raises(ParameterError) as caught:
-        validate_text(edited(**changes))
-    found = {(p.path, p.code) for p in caught.value.problems}
-    assert any(p == path and (code is None or c == code) for p, c in found), found
+        build(params, None, effects=["cam"])
+    assert (path, code) in {(p.path, p.code) for p in caught.value.problems}
+
+
+def test_unknown_cam_law_is_refused_at_load():
+    with pytest.raises(ParameterError) as caught:
+        validate_text(edited(rise_law='"cycloid"'))
+    assert any(p.path == "cam.rise_law" and p.stage is None for p in caught.value.problems)
 
 
 def test_cam_dxf_is_one_closed_cutting_path_within_the_chord_tolerance(paper, tmp_path):

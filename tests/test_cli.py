@@ -2,16 +2,27 @@
 
 from __future__ import annotations
 
+import os
+import re
 import subprocess
 import sys
+import time
 import types
 from pathlib import Path
 
 import pytest
 
 import cadgen
+import cadgen.atomic
 import cadgen.feasibility
-from cadgen.cli import EXIT_OK, EXIT_PROBLEMS, main
+from cadgen.cli import (
+    CRASH_DIR_VARIABLE,
+    EXIT_INTERNAL,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_PROBLEMS,
+    main,
+)
 from kinematics.errors import ConvergenceError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -185,3 +196,224 @@ def test_analyze_rejects_bad_steps(fake_analysis, steps, capsys):
     assert caught.value.code == 2
     assert "--steps" in capsys.readouterr().err
     assert fake_analysis.calls == []
+
+
+# --------------------------------------------------------------------------- errors: one line each
+
+
+def test_internal_error_exits_3_with_one_line_and_a_crash_file(fake_analysis, tmp_path,
+                                                               monkeypatch, capsys):
+    import platform
+
+    crash_dir = tmp_path / "crashes"
+    monkeypatch.setenv(CRASH_DIR_VARIABLE, str(crash_dir))
+    fake_analysis.fail = RuntimeError("stage table\nlost its 42nd row")
+    argv = ["build", str(REFERENCE), "--output-dir", str(tmp_path / "out")]
+    assert main(argv) == EXIT_INTERNAL == 3
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    (line,) = captured.err.splitlines()
+    assert line.startswith("cadgen: internal error: RuntimeError: stage table lost its 42nd row "
+                           "(please report it; traceback saved to ")
+    (crash,) = crash_dir.iterdir()
+    assert line.endswith(f"{crash})")
+    assert re.fullmatch(rf"cadgen-crash-\d{{8}}-\d{{6}}-{os.getpid()}\.txt", crash.name)
+    text = crash.read_text(encoding="utf-8")
+    assert "Traceback (most recent call last):" in text
+    assert "RuntimeError: stage table\nlost its 42nd row" in text
+    assert "in _cmd_build" in text                       # where it happened
+    assert f"cadgen {cadgen.__version__} " in text
+    assert f"python {platform.python_version()} " in text
+    assert repr(argv)[1:-1] in text                      # the command line, whole
+    assert not (tmp_path / "out").exists()
+
+
+def test_internal_error_in_validate_is_3_too(tmp_path, monkeypatch, capsys):
+    import cadgen.params
+
+    monkeypatch.setenv(CRASH_DIR_VARIABLE, str(tmp_path))
+
+    def broken(path):
+        raise TypeError("unsupported operand type(s) for +: 'NoneType' and 'float'")
+
+    monkeypatch.setattr(cadgen.params, "load_params", broken)
+    assert main(["validate", str(REFERENCE)]) == EXIT_INTERNAL
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "internal error: TypeError: unsupported operand" in line
+    assert len(list(tmp_path.glob("cadgen-crash-*.txt"))) == 1
+
+
+def test_internal_error_when_the_crash_file_cannot_be_written(fake_analysis, tmp_path,
+                                                               monkeypatch, capsys):
+    blocker = tmp_path / "not-a-directory"
+    blocker.write_text("")
+    monkeypatch.setenv(CRASH_DIR_VARIABLE, str(blocker / "crashes"))
+    fake_analysis.fail = ValueError("bad")
+    assert main(["build", str(REFERENCE), "--output-dir", str(tmp_path / "out")]) == EXIT_INTERNAL
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith("cadgen: internal error: ValueError: bad (please report it; "
+                           "the traceback could not be saved: ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["not-a-directory"]
+
+
+def test_crash_file_goes_to_the_temporary_directory_by_default(fake_analysis, tmp_path,
+                                                                monkeypatch, capsys):
+    import tempfile
+
+    monkeypatch.delenv(CRASH_DIR_VARIABLE, raising=False)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    fake_analysis.fail = KeyError("x")
+    assert main(["build", str(REFERENCE), "--output-dir", str(tmp_path / "out")]) == EXIT_INTERNAL
+    (crash,) = tmp_path.glob("cadgen-crash-*.txt")
+    assert str(crash) in capsys.readouterr().err
+
+
+def test_keyboard_interrupt_exits_130_with_one_line(fake_analysis, tmp_path, capsys):
+    fake_analysis.fail = KeyboardInterrupt()
+    assert main(["build", str(REFERENCE), "--output-dir", str(tmp_path / "out")]) \
+        == EXIT_INTERRUPTED == 130
+    captured = capsys.readouterr()
+    assert captured.err == "cadgen: interrupted\n" and captured.out == ""
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_keyboard_interrupt_during_a_real_build_leaves_no_folder(tmp_path, monkeypatch, capsys):
+    import cadgen.build
+
+    def interrupted(run):
+        raise KeyboardInterrupt
+
+    # the solids stage is interrupted after the metrics and cam ran: nothing may be written
+    monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, "parts", interrupted)
+    out = tmp_path / "out"
+    (out / "xin2024-planter").mkdir(parents=True)
+    (out / "xin2024-planter" / "previous.txt").write_text("kept")
+    assert main(["build", str(REFERENCE), "--output-dir", str(out),
+                 "--effects", "metrics,solids"]) == EXIT_INTERRUPTED
+    assert capsys.readouterr().err == "cadgen: interrupted\n"
+    assert sorted(p.name for p in out.iterdir()) == ["xin2024-planter"]
+    assert (out / "xin2024-planter" / "previous.txt").read_text() == "kept"
+
+
+def test_the_sigint_handler_is_put_back(fake_analysis, tmp_path):
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    main(["build", str(REFERENCE), "--output-dir", str(tmp_path / "out")])
+    assert signal.getsignal(signal.SIGINT) is before
+
+
+def _unusable_output_dirs(tmp_path):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    return {"proc": (Path("/proc/x"), "/proc"),
+            "existing-file": (afile, "is a file, not a directory"),
+            "under-a-file": (afile / "out", f"{afile} is a file")}
+
+
+@pytest.mark.skipif(not Path("/proc/self").exists(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("case", ["proc", "existing-file", "under-a-file"])
+@pytest.mark.parametrize("command", ["build", "analyze", "batch"])
+def test_unusable_output_dir_exits_2_before_any_work(case, command, tmp_path, monkeypatch,
+                                                     capsys):
+    import cadgen.batch
+    import cadgen.build
+    import cadgen.params
+
+    def no_work(*args, **kwargs):
+        pytest.fail("work started although the output directory cannot be used")
+
+    for module, name in ((cadgen.build, "build"), (cadgen.params, "load_params"),
+                         (cadgen.batch, "run_batch"), (cadgen.batch, "expand_grid")):
+        monkeypatch.setattr(module, name, no_work)
+    directory, reason = _unusable_output_dirs(tmp_path)[case]
+    before = sorted(tmp_path.rglob("*"))
+    args = [command, str(REFERENCE)] if command != "batch" else [command, "--grid",
+                                                                 str(ROOT / "params" / "grids"
+                                                                     / "l2-sweep.toml")]
+    start = time.perf_counter()
+    assert main([*args, "--output-dir", str(directory)]) == EXIT_PROBLEMS
+    assert time.perf_counter() - start < 1.0
+    captured = capsys.readouterr()
+    (line,) = captured.err.splitlines()
+    assert line.startswith(f"cadgen: output directory {directory}: ") and reason in line
+    assert captured.out == ""
+    assert sorted(tmp_path.rglob("*")) == before       # nothing written
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0,
+                    reason="POSIX permissions; root writes into read-only directories")
+def test_read_only_output_dir_exits_2(tmp_path, capsys, fake_analysis):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        assert main(["build", str(REFERENCE), "--output-dir", str(locked / "out")]) \
+            == EXIT_PROBLEMS
+    finally:
+        locked.chmod(0o755)
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == (f"cadgen: output directory {locked / 'out'}: cannot be made: no folder can "
+                    f"be created in {locked} (Permission denied)")
+    assert fake_analysis.calls == [] and list(locked.iterdir()) == []
+
+
+def test_unwritable_output_dir_is_found_by_trying(tmp_path, capsys, fake_analysis, monkeypatch):
+    """Permission bits say nothing to root or on a read-only mount: the check tries."""
+    import tempfile
+
+    def refused(*args, **kwargs):
+        raise OSError(30, "Read-only file system")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", refused)
+    assert main(["build", str(REFERENCE), "--output-dir", str(tmp_path)]) == EXIT_PROBLEMS
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == (f"cadgen: output directory {tmp_path}: not writable: no folder can be "
+                    "created in it (Read-only file system)")
+    assert fake_analysis.calls == []
+
+
+def test_design_folder_that_is_a_file_is_refused_before_any_stage(tmp_path, monkeypatch, capsys):
+    import cadgen.build
+
+    def no_stage(run):
+        pytest.fail("a stage ran")
+
+    for stage in list(cadgen.build.STAGE_FUNCTIONS):
+        monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, stage, no_stage)
+    (tmp_path / "xin2024-planter").write_text("a file where the outputs would go")
+    assert main(["build", str(REFERENCE), "--output-dir", str(tmp_path)]) == EXIT_PROBLEMS
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == (f"cadgen: output directory {tmp_path}: {tmp_path / 'xin2024-planter'} exists "
+                    "and is not a directory, so the design's outputs cannot go there")
+    assert (tmp_path / "xin2024-planter").read_text() == "a file where the outputs would go"
+
+
+def test_library_build_raises_output_dir_error(tmp_path):
+    from cadgen.atomic import OutputDirError
+    from cadgen.build import build
+    from cadgen.params import load_params
+
+    with pytest.raises(OutputDirError, match="is a file") as caught:
+        (tmp_path / "f").write_text("")
+        build(load_params(REFERENCE), tmp_path / "f" / "out", effects=["metrics"])
+    assert caught.value.directory == tmp_path / "f" / "out"
+    assert isinstance(caught.value, cadgen.atomic.MechanismError)
+
+
+def test_a_reader_that_goes_away_is_a_quiet_141(monkeypatch, capsys):
+    # `cadgen build ... | head`: the pipe closes under the summary; no "internal error"
+    import argparse
+    import os
+
+    import cadgen.cli
+
+    def closed(args: argparse.Namespace) -> int:
+        raise BrokenPipeError(32, "Broken pipe")
+
+    redirected = []
+    monkeypatch.setattr(cadgen.cli, "_cmd_validate", closed)
+    monkeypatch.setattr(os, "dup2", lambda source, target: redirected.append(target))
+    assert main(["validate", str(REFERENCE)]) == cadgen.cli.EXIT_BROKEN_PIPE == 141
+    assert capsys.readouterr().err == ""
+    assert redirected in ([], [1])   # stdout to /dev/null where it is a file (not here)

@@ -781,9 +781,9 @@ def test_number_mutations_pass_the_feasibility_check_without_a_traceback(kind, e
         ("pricking", ("field", "carrier_speed_rpm"), 5e-324, "out_of_range"),
         # overflow in the duckbill linkage
         ("planting", ("cam", "duckbill", "blade_length"), 5e-324, "out_of_range"),
-        # a sun centre 10 m away: the ratio dips below zero where the extreme search does
-        # not look, and a power of it was a NaN before the verdict
-        ("pricking", ("trajectory", "sun_centre"), [-10000.0, 0.0], "ratio_not_positive"),
+        # (a sun centre 10 m away was here as ratio_not_positive: a dense direct evaluation
+        # shows the ratio stays within 0.9947..1.0050, so it is a design, checked against
+        # that reference in tests/test_pricking_hard.py)
     ],
     ids=lambda v: ".".join(v) if isinstance(v, tuple) else str(v).replace(" ", ""),
 )

@@ -217,8 +217,8 @@ def test_example_comments_name_every_quantity(path):
         assert "#" in stripped, line  # key = value lines and the point lines
         checked += 1
     # top level 2; [trajectory] 15 (points = [, 12 points, degree, sun_centre); [linkage] 1;
-    # [gears] 5; [field] 4; [resolution] 1
-    assert checked == 2 + 15 + 1 + 5 + 4 + 1
+    # [gears] 6; [field] 4; [resolution] 1
+    assert checked == 2 + 15 + 1 + 6 + 4 + 1
     assert "mirror" in text.lower()  # the header says the spec's points are mirrored in x
     assert "assumed" in text  # the forward speed is an assumption, not the paper's
 
@@ -387,6 +387,8 @@ def test_single_problem_cases(key, value, path, code):
         ("gears", "pressure_angle_deg = 0", "gears.pressure_angle_deg", "out_of_range"),
         ("gears", "addendum = -1.0", "gears.addendum", "out_of_range"),
         ("gears", "min_ratio = 0.0", "gears.min_ratio", "out_of_range"),
+        ("gears", "max_scale_change = 0.0", "gears.max_scale_change", "out_of_range"),
+        ("gears", "max_scale_change = 0.8", "gears.max_scale_change", "out_of_range"),
         ("gears", "teeth = 30", "gears.teeth", "unknown_key"),
         ("field", "carrier_speed_rpm = -75", "field.carrier_speed_rpm", "out_of_range"),
         ("field", "plant_spacings = [150.0]", "field.plant_spacings", "unknown_key"),

@@ -373,3 +373,60 @@ def test_render_script_says_when_chromium_is_missing(tmp_path, capsys):
     error = capsys.readouterr().err
     assert "Chromium was not found" in error and "apt-get install -y chromium" in error
     assert not (tmp_path / "shot.png").exists()
+
+
+#: The standard preset as the README documents it (an independent source of the values).
+README_STANDARD = {"resolution.steps_per_revolution": "3600", "resolution.closure_rtol": "1e-13",
+                   "resolution.sweep_atol": "1e-06", "gears.flank_points": "96",
+                   "gears.chord_tolerance": "0.005", "solids.segments_per_circle": "96",
+                   "cam.profile_points": "3600"}
+
+
+def test_preset_is_a_table_of_knobs_with_their_origin(planting):
+    import tomllib
+
+    page = render_html(planting, {})
+    parse(page)
+    assert "{'" not in page and "&#x27;value&#x27;" not in page and "{&#x27;" not in page
+    header = re.search(r"<header>(.*?)</header>", page, re.S)[1]
+    preset = re.search(r'<div class="preset">(.*?)</div>(<table>.*?</table>)', header, re.S)
+    table = rows(preset[2])
+    assert table[0] == ["knob", "value", "from"]
+    written = tomllib.loads(REFERENCE.read_text(encoding="utf-8"))
+    in_file = {f"{section}.{key}" for section, values in written.items()
+               if isinstance(values, dict) for key in values}
+    assert {row[0] for row in table[1:]} == set(README_STANDARD)   # one row per knob
+    for knob, value, source in table[1:]:
+        section, key = knob.split(".")
+        if knob in in_file:
+            assert source == "the parameter file"
+            assert float(value) == float(written[section][key])
+        else:
+            assert source == "preset standard"
+            assert value == README_STANDARD[knob]
+    from_file = sum(knob in in_file for knob in README_STANDARD)
+    assert html.unescape(preset[1]) == (f"standard ({len(README_STANDARD)} knobs: {from_file} from "
+                                        f"the parameter file, {len(README_STANDARD) - from_file} "
+                                        "from the preset)")
+
+
+def test_preset_of_an_older_report_is_text(planting):
+    report = dict(planting, preset="fine")
+    page = render_html(report, {})
+    assert "<tr><td>preset</td><td>fine</td></tr>" in page
+
+
+def test_an_undecided_metric_and_the_warnings_are_shown(planting):
+    # a search whose gap straddles the target is neither pass nor fail; checks of stages
+    # the build did not run are listed as warnings with their stage
+    report = copy.deepcopy(planting)
+    report["metrics"][2].update(passed=False, verdict="undecided")
+    report["passed"] = False
+    report["warnings"] = [{"path": "cam.lever.roller_arm", "code": "push_rod_inverted",
+                           "message": "the push rod would sit above the lever pin", "stage": "cam"}]
+    page = render_html(report, {})
+    rows = re.findall(r"<tr[^>]*>.*?</tr>", section(page, "metrics"), re.S)[1:]
+    assert ">UNDECIDED<" in rows[2] and ">FAIL<" not in rows[2]
+    assert "push_rod_inverted" in page and "stage cam, not run in this build" in page
+    assert "1 warning (stages not run)" in page
+    assert "Warnings" not in render_html(planting, {})

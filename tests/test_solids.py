@@ -150,7 +150,7 @@ def test_pricking_needle_tip_follows_the_designed_loop(pricking):
         vertices = needle.mesh.vertices @ pose[:3, :3].T + pose[:3, 3]
         # the needle's point is its one vertex farthest from B; it must sit on the loop
         far = vertices[np.argmax(np.linalg.norm(vertices[:, :2] - pose[:2, 3], axis=1))]
-        start = float(design.motion.phi1(0.0))
+        start = design.motion.phi1_start  # the assembly's carrier angle counts from Rmax
         v = design.motion.invert(np.array([start + design.motion.sense * angle]))
         assert np.linalg.norm(far[:2] - design.motion.tip(v)[0]) < 1e-6
 

@@ -17,11 +17,46 @@ from .summary import _order
 __all__ = ["run_batch"]
 
 
+#: A local worker's state for Ctrl-C (see :func:`_worker_start`).
+_WORKER = {"pid": None, "busy": False, "interrupted": False}
+
+
+def _worker_start() -> None:
+    """Initializer of a local worker: Ctrl-C stops its design, cleanly, without a traceback.
+
+    The terminal sends SIGINT to the whole process group, the workers included. A busy
+    worker raises KeyboardInterrupt in its job (which kills its design's process group
+    and removes its staging folder, see :func:`run_design_isolated`); an idle one only
+    remembers it and starts no further design (a design already queued to it is
+    refused); a process forked from the worker ends quietly. The batch's own process
+    reports the interrupt once.
+    """
+    import signal
+
+    _WORKER["pid"] = os.getpid()
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        signal.signal(signal.SIGINT, _worker_interrupt)
+
+
+def _worker_interrupt(signum, frame) -> None:
+    if _WORKER["pid"] != os.getpid():
+        os._exit(130)
+    _WORKER["interrupted"] = True
+    if _WORKER["busy"]:
+        raise KeyboardInterrupt
+
+
 def _run_job(job, output_root, build, build_kwargs, timeout, isolate) -> dict:
     """What a worker runs for one design."""
-    if isolate:
-        return run_design_isolated(job, output_root, build, build_kwargs, timeout)
-    return run_design(job, output_root, build, build_kwargs)
+    if _WORKER["interrupted"]:
+        raise KeyboardInterrupt(f"interrupted before {job.name} started")
+    _WORKER["busy"] = True
+    try:
+        if isolate:
+            return run_design_isolated(job, output_root, build, build_kwargs, timeout)
+        return run_design(job, output_root, build, build_kwargs)
+    finally:
+        _WORKER["busy"] = False
 
 
 # --------------------------------------------------------------------------- executors
@@ -51,11 +86,19 @@ def _run_local(jobs, output_root, task, workers, on_result):
     # spawn: one start method on every platform, safe when the parent holds threads (a
     # Dask client); each worker pays its imports once and forks each design from there.
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))), mp_context=context)
+    pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))), mp_context=context,
+                               initializer=_worker_start)
+    futures = {}
     try:
-        futures = {pool.submit(_run_job, job, output_root, *task): job for job in jobs}
+        for job in jobs:
+            futures[pool.submit(_run_job, job, output_root, *task)] = job
         summaries = _collect(futures, as_completed(futures), on_result)
     except BaseException:
+        # Cancelled here, not only through shutdown(cancel_futures=True): the pool's
+        # manager thread cancels through a weak reference to the pool, which may be gone
+        # by the time it looks, and then every queued design would still be built.
+        for future in futures:
+            future.cancel()
         pool.shutdown(wait=False, cancel_futures=True)
         raise
     pool.shutdown()

@@ -59,7 +59,11 @@ wrong shape or a non-number item, ``not_finite`` for nan or inf); too few points
 the array itself (``trajectory.points``, ``out_of_range``).
 
 Once the file is structurally valid, :func:`cadgen.feasibility.design_problems`
-adds the problems that need the kinematic model (their codes are its own).
+adds the problems that need the kinematic model (their codes are its own). Those of
+one build stage (the duckbill linkage and cam timing: stage ``cam``) do not refuse
+the file: they come back attached to the parameters (:func:`stage_problems`) and a
+build refuses the design only when its scene runs that stage (otherwise they are
+warnings in its report).
 Validation never writes anything.
 
 Modules: :mod:`~cadgen.params.planting` and :mod:`~cadgen.params.pricking` (the tables
@@ -77,6 +81,7 @@ from .loading import (
     DesignParameters,
     ParameterError,
     load_params,
+    stage_problems,
     validate_data,
     validate_text,
 )
@@ -162,4 +167,5 @@ __all__ = [
     "load_params",
     "validate_text",
     "validate_data",
+    "stage_problems",
 ]

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, get_args, get_origin
 
-from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator
+from pydantic import BaseModel, ConfigDict, PrivateAttr, ValidationInfo, field_validator
 from pydantic_core import PydanticCustomError
 
 __all__ = [
@@ -47,6 +47,10 @@ class _Table(BaseModel):
     """Base of every table: frozen, no unknown keys, strict types, finite floats up to 1e6."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
+
+    # On a whole design: the problems of build stages validation found (not a field, so
+    # not in the file, the hash or model_dump); see cadgen.params.loading.stage_problems.
+    _stage_problems: tuple = PrivateAttr(default=())
 
     @field_validator("*")
     @classmethod

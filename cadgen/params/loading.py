@@ -8,6 +8,12 @@ against :data:`DesignParameters`, the union of the mechanism kinds told apart by
 :func:`cadgen.feasibility.design_problems` adds the problems that need the kinematic
 model; it is imported inside the call, so parsing alone (and ``cadgen --help``) does
 not pay for numpy and scipy. Validation never writes anything.
+
+A problem that belongs to one build stage (``Problem.stage``, e.g. the duckbill
+linkage to ``"cam"``) does not refuse the file on its own: the parameters come back
+with it attached (:func:`stage_problems`), and :func:`cadgen.build.build` makes it an
+error when the scene runs that stage and a warning otherwise. A file with other
+problems is refused with all of them, the staged ones among them.
 """
 
 from __future__ import annotations
@@ -42,6 +48,7 @@ __all__ = [
     "validate_text",
     "validate_data",
     "parse_toml",
+    "stage_problems",
 ]
 
 
@@ -50,6 +57,15 @@ class ParameterError(DesignError):
 
     Also a :class:`ValueError` (through :class:`~kinematics.errors.DesignError`).
     """
+
+
+def stage_problems(params) -> tuple:
+    """The problems of build stages validation found in ``params`` (empty if none or not checked).
+
+    Each has its ``stage``; a build running that stage refuses the design, any other
+    build reports them as warnings (see :func:`validate_data`).
+    """
+    return tuple(getattr(params, "_stage_problems", None) or ())
 
 
 DesignParameters = Annotated[
@@ -136,12 +152,14 @@ def validate_data(
     -------
     PlantingParameters or PrickingParameters
         The validated, frozen parameters (the member of :data:`DesignParameters`
-        that ``mechanism`` names).
+        that ``mechanism`` names), with the problems of build stages found, if any,
+        attached: :func:`stage_problems` (a metrics-only evaluation may go on).
 
     Raises
     ------
     ParameterError
-        Listing every problem found.
+        Listing every problem found, when one belongs to no stage (the staged ones
+        are listed too).
     """
     if not isinstance(data, Mapping):
         problem = Problem("", "wrong_type", f"expected a table, not {_describe(data)}")
@@ -150,10 +168,14 @@ def validate_data(
     if problems:
         raise ParameterError(problems, source)
     params, problems = _structural(data)
+    staged = []
     if not problems and check_feasibility:
         problems = _feasibility_problems(params)
-    if problems:
+        staged = [p for p in problems if p.stage]
+    if len(problems) > len(staged):
         raise ParameterError(problems, source)
+    if staged:
+        params._stage_problems = tuple(staged)
     return params
 
 

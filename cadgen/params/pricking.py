@@ -170,6 +170,10 @@ class GearParameters(CuttingParameters):
     min_ratio: float = Field(
         0.05, gt=0, description="lower bound of the total relative ratio i, dimensionless"
     )
+    max_scale_change: float = Field(
+        0.05, gt=0, le=0.5,
+        description="largest change of scale, as a fraction, the design may take so that "
+                    "stage 1 holds whole teeth at the module (0.05 = 5 %)")
 
     @field_validator("split_exponent", mode="before")
     @classmethod

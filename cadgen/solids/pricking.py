@@ -37,7 +37,7 @@ __all__ = ["pricking_assembly"]
 def _pose_parameters(design, angle):
     """Curve parameter ``v`` and carrier angle ``phi1`` after the carrier turned by ``angle``."""
     motion = design.motion
-    start = float(motion.phi1(0.0))
+    start = motion.phi1_start
     turns, rest = divmod(float(angle), 2 * math.pi)
     phi1 = start + motion.sense * rest
     v = float(motion.invert(np.array([phi1]))[0])
@@ -62,7 +62,7 @@ def pricking_assembly(params, design, train, field):
     needle = needle_geometry(design)
     housing = params.housing
     gap = housing.axial_gap
-    start = float(motion.phi1(0.0))
+    start = motion.phi1_start
     poses = {}
 
     def pose_of(angle):
@@ -117,7 +117,8 @@ def pricking_assembly(params, design, train, field):
                 # in the case's frame the line of centres stays where it was at the start, so
                 # a gear sits where it started, turned by the pair's rotation at the pose
                 v, _ = pose_of(angle)
-                turn = float(stage.generated.pair.rotations(np.array([v]))[which][0])
+                tau = motion.cycle(np.array([v]))   # the pairs' cycle starts at the Rmax dead centre
+                turn = float(stage.generated.pair.rotations(tau)[which][0])
                 return planar_transform(stage.placement[0] + turn, at, z)
 
             solid, outline = gear_solid(profile, faces[index], segments, path="gears.face_width",

@@ -1,0 +1,164 @@
+"""End to end: the real ``cadgen`` console script on every bundled example, as a user runs it.
+
+Files are found by glob (``params/*.toml``, ``params/grids/*.toml``), so a new example is
+covered without touching this file. Each run must end without a traceback and with exit
+0 or 1; what it prints and writes is checked against the input files themselves (read
+here with tomllib) and against report.json, not against the code that made them.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PARAMS = sorted((ROOT / "params").glob("*.toml"))
+GRIDS = sorted((ROOT / "params" / "grids").glob("*.toml"))
+CADGEN = Path(sys.executable).with_name("cadgen")
+TIMEOUT = 300
+
+
+def cadgen(*args, cwd: Path) -> subprocess.CompletedProcess:
+    assert CADGEN.is_file(), f"no console script next to {sys.executable}: pip install -e ."
+    return subprocess.run([str(CADGEN), *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, timeout=TIMEOUT)
+
+
+def no_traceback(result: subprocess.CompletedProcess) -> None:
+    for stream in (result.stdout, result.stderr):
+        assert "Traceback" not in stream, stream[-3000:]
+        assert "internal error" not in stream, stream[-3000:]
+
+
+def toml(path: Path) -> dict:
+    return tomllib.loads(path.read_text(encoding="utf-8"))
+
+
+def test_examples_are_found():
+    assert len(PARAMS) >= 3 and len(GRIDS) >= 1
+    assert {p.name for p in PARAMS} >= {"xin2024-planter.toml", "kernel-a.toml", "kernel-b.toml"}
+
+
+@pytest.mark.parametrize("file", PARAMS, ids=[p.stem for p in PARAMS])
+def test_validate_every_example(file, tmp_path):
+    result = cadgen("validate", file, cwd=tmp_path)
+    no_traceback(result)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert result.stdout.splitlines()[0] == f"{file}: ok"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("file", PARAMS, ids=[p.stem for p in PARAMS])
+def test_build_every_example(file, tmp_path):
+    data = toml(file)
+    name, mechanism = data["name"], data["mechanism"]
+    result = cadgen("build", file, "--output-dir", tmp_path / "out", cwd=tmp_path)
+    no_traceback(result)
+    assert result.returncode in (0, 1), result.stdout[-2000:] + result.stderr[-2000:]
+    folder = tmp_path / "out" / name
+    report = json.loads((folder / "report.json").read_text(encoding="utf-8"))
+    assert report["design"] == name and report["mechanism"] == mechanism
+    # the exit code is the report's verdict: 0 exactly when nothing failed
+    assert result.returncode == (0 if report["passed"] else 1)
+    assert (result.returncode == 0) == (report["failures"] == [])
+    # no staging or set-aside folder left beside the outputs
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [name]
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith(f"design {name} ({mechanism} mechanism)")
+    assert lines[-1] == f"wrote {len(report['files'])} files to {tmp_path / 'out' / name}"
+    assert ("PASSED" if report["passed"] else "NOT PASSED") in result.stdout
+    # every file the report lists is there
+    assert all((folder / f).is_file() for f in report["files"])
+    # each clearance line carries the certified minimum of report.json, and says plainly
+    # when the mechanism has no kinematic estimate (the pricking gear case)
+    for row in report.get("sweep", {}).values():
+        line = next(x for x in lines if x.startswith(row["label"] + ":"))
+        assert f": {row['minimum_mm']:.3f} mm (certified >= " in line
+        if row["kinematic_estimate_mm"] is None:
+            assert "no kinematic estimate for this mechanism" in line
+        else:
+            assert f"kinematic estimate {row['kinematic_estimate_mm']:.3f} mm" in line
+    if mechanism == "pricking":
+        assert "sweep" in report and "no kinematic estimate" in result.stdout
+
+
+def _grid_size(grid: dict) -> int:
+    """Designs in a grid file: the product of its lists' lengths (``{num}`` for a range)."""
+    return math.prod(len(v) if isinstance(v, list) else int(v["num"])
+                     for v in grid["grid"].values())
+
+
+@pytest.mark.parametrize("grid", GRIDS, ids=[g.stem for g in GRIDS])
+def test_batch_every_grid(grid, tmp_path):
+    data = toml(grid)
+    count = _grid_size(data)
+    out = tmp_path / "out"
+    result = cadgen("batch", "--grid", grid, "--output-dir", out, "--workers", 2, cwd=tmp_path)
+    no_traceback(result)
+    assert result.returncode in (0, 1), result.stdout[-2000:] + result.stderr[-2000:]
+    with open(out / "batch-summary.csv", newline="", encoding="utf-8") as stream:
+        table = list(csv.DictReader(stream))
+    names = [f"{data['name']}-{k:03d}" for k in range(1, count + 1)]
+    assert sorted(row["design"] for row in table) == names
+    # every combination of the grid's values, once
+    for key, values in data["grid"].items():
+        if isinstance(values, list):
+            assert sorted({float(row[f"grid:{key}"]) for row in table}) == sorted(values)
+    built = sorted(p.name for p in out.iterdir() if p.is_dir())
+    assert not [n for n in built if n.startswith(".")]        # no staging folder left
+    assert built == sorted(row["design"] for row in table if row["output"])
+    for name in built:
+        report = json.loads((out / name / "report.json").read_text(encoding="utf-8"))
+        assert report["design"] == name
+    failed = sum(not row["output"] for row in table)
+    assert result.returncode == (1 if failed else 0)
+    assert f"{count} designs in " in result.stdout
+
+
+def _interrupt(args, delay: float, cwd: Path):
+    """Start the real script in its own process group, SIGINT the group after ``delay`` s
+    (as Ctrl-C does to a terminal's foreground job); (exit code, stderr, seconds after
+    the signal)."""
+    process = subprocess.Popen([str(CADGEN), *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    time.sleep(delay)
+    signalled = time.perf_counter()
+    os.killpg(process.pid, signal.SIGINT)
+    _, stderr = process.communicate(timeout=TIMEOUT)
+    return process.returncode, stderr, time.perf_counter() - signalled
+
+
+@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX)")
+def test_ctrl_c_during_a_build_leaves_nothing(tmp_path):
+    out = tmp_path / "out"
+    # 1.5 s in: the teeth are being cut while a forked worker runs the FCL sweeps
+    code, stderr, _ = _interrupt(["build", ROOT / "params" / "xin2024-planter.toml",
+                                  "--output-dir", out], 1.5, tmp_path)
+    assert code == 130, stderr
+    assert stderr == "cadgen: interrupted\n"    # the forked workers print nothing
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX)")
+def test_ctrl_c_stops_a_batch_promptly(tmp_path):
+    out = tmp_path / "out"
+    code, stderr, after = _interrupt(["batch", "--grid", GRIDS[0], "--output-dir", out,
+                                      "--workers", "2"], 2.0, tmp_path)
+    assert code == 130, stderr
+    lines = [line for line in stderr.splitlines() if not line.startswith("[")]  # progress
+    assert lines == ["cadgen: interrupted"]
+    assert after < 5.0          # the queued designs are not built after the interrupt
+    left = sorted(p.name for p in out.iterdir()) if out.exists() else []
+    assert not [n for n in left if n.startswith(".")], left
+    for name in left:           # a design already built is whole
+        assert (out / name / "report.json").is_file()
