@@ -222,15 +222,17 @@ class _RadialGaps:
         return np.clip(np.searchsorted(knots, np.mod(u, self.curve.period), side="right") - 1,
                        0, len(knots) - 2)
 
-    def _shifted(self, span: int, anchor: float) -> np.ndarray:
-        """Power coefficients of span ``span``'s polynomial about ``anchor``: (degree + 1, 2)."""
+    def _shifted(self, spans, anchors) -> np.ndarray:
+        """Power coefficients of each span's polynomial about its anchor: (k, degree + 1, 2)."""
         from math import comb
 
         degree = self.curve.degree
-        h = anchor - self._middles[span]
-        shift = np.array([[comb(q, r) * h ** (q - r) if q >= r else 0.0
-                           for q in range(degree + 1)] for r in range(degree + 1)])
-        return shift @ self._middle_coefficients[span]
+        h = np.asarray(anchors, dtype=float) - self._middles[spans]
+        q, r = np.meshgrid(np.arange(degree + 1), np.arange(degree + 1))
+        binomial = np.array([[comb(int(a), int(b)) if a >= b else 0 for a in range(degree + 1)]
+                             for b in range(degree + 1)], dtype=float)   # [r, q] = C(q, r)
+        powers = np.where(q >= r, h[:, None, None] ** np.maximum(q - r, 0), 0.0)
+        return np.einsum("krq,kqd->krd", binomial * powers, self._middle_coefficients[spans])
 
     @staticmethod
     def _increment(coefficients, step):
@@ -245,26 +247,30 @@ class _RadialGaps:
         """Per span: an anchor parameter, ``p(anchor) - p(u*)`` and coefficients about the anchor.
 
         The anchor is ``u*`` in its own span, else the span's end nearer ``u*``
-        along the chain; going half the loop forwards and the rest backwards
-        keeps every chain short.
+        along the chain; half the loop is chained forwards and the rest backwards,
+        so every chain is short, and each chain is a cumulative sum of whole-span
+        increments (each exact to its own rounding).
         """
         knots = self.curve.knots
         count = len(knots) - 1
+        widths = np.diff(knots)
         own = int(self._span(np.array([u_star]))[0])
+        forward = (own + 1 + np.arange(count // 2)) % count
+        backward = (own - 1 - np.arange(count - count // 2 - 1)) % count
         anchors = np.empty(count)
+        anchors[own], anchors[forward], anchors[backward] = u_star, knots[forward], knots[backward + 1]
+        coefficients = self._shifted(np.arange(count), anchors)
         offsets = np.zeros((count, 2))
-        coefficients = np.empty((count, self.curve.degree + 1, 2))
-        anchors[own], coefficients[own] = u_star, self._shifted(own, u_star)
-        for direction, steps in ((1, count // 2), (-1, count - count // 2 - 1)):
-            previous = own
-            for step in range(1, steps + 1):
-                span = (own + direction * step) % count
-                end = knots[previous + 1] if direction > 0 else knots[previous]
-                offsets[span] = offsets[previous] + self._increment(
-                    coefficients[previous], end - anchors[previous])
-                anchors[span] = knots[span] if direction > 0 else knots[span + 1]
-                coefficients[span] = self._shifted(span, anchors[span])
-                previous = span
+        if forward.size:
+            steps = np.concatenate([
+                self._increment(coefficients[own], knots[own + 1] - u_star)[None],
+                self._increment(coefficients[forward[:-1]], widths[forward[:-1]])])
+            offsets[forward] = np.cumsum(steps, axis=0)
+        if backward.size:
+            steps = np.concatenate([
+                self._increment(coefficients[own], knots[own] - u_star)[None],
+                self._increment(coefficients[backward[:-1]], -widths[backward[:-1]])])
+            offsets[backward] = np.cumsum(steps, axis=0)
         return anchors, offsets, coefficients
 
     def __call__(self, u):

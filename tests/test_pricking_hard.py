@@ -255,3 +255,28 @@ def test_concave_stretches_are_merged_and_read_once(bases):
     messages = " ".join(f.message for f in design.findings)
     for low, high in (s["carrier_deg"] for g in design.gears for s in g.concave_stretches):
         assert f"{low:.1f} to {low:.1f} deg" not in messages
+
+
+@pytest.mark.parametrize("which", ["outer", "inner"])
+def test_the_gap_to_a_dead_centre_circle_is_an_exact_parabola(which):
+    # R(u) - R* = R''/2 du^2 + O(du^3): the plain difference loses it below ~1e-5 mm, the
+    # chained expansion keeps it down to 1e-7 mm, on whichever side of a nearby knot
+    from kinematics.pricking import _RadialGaps, link_lengths
+
+    points, _ = point_on_curve_near_dead_centre(KERNEL_B, 5, which, 0.003)
+    curve = ClosedCurve(points, 5)
+    link = link_lengths(curve, (0.0, 0.0), 45.0)
+    gaps = _RadialGaps(curve, link)
+    u_star = link.u_max if which == "outer" else link.u_min
+    index = 1 if which == "outer" else 2
+    steps = np.array([1e-7, 1e-6, 1e-5, 1e-4])
+    for side in (-1.0, 1.0):
+        gap = gaps(u_star + side * steps)[index]
+        curvature = gap / steps**2
+        np.testing.assert_allclose(curvature, curvature[0], rtol=1e-3)
+        assert np.all(gap > 0.0)
+    # far from the dead centres it is the plain difference
+    u = np.linspace(0.0, curve.period, 2001)
+    radius, outer, inner = gaps(u)
+    np.testing.assert_allclose(outer, link.l + 2 * link.a - radius, atol=1e-11)
+    np.testing.assert_allclose(inner, radius - (link.l - 2 * link.a), atol=1e-11)
