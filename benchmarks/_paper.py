@@ -13,10 +13,10 @@ _Z = (0.0, 0.0, 1.0)
 
 def sweep_cases():
     """``[(label, scene factory, lipschitz, acceleration, upper)]`` with the build's own bounds."""
-    from cadgen.build import STAGE_FUNCTIONS, _Build
-    from cadgen.clearances import ARM_PARTS, _arm_bounds
+    from cadgen.pipeline.build import STAGE_FUNCTIONS, _Build
+    from cadgen.pipeline.clearances import ARM_PARTS, _arm_bounds
     from cadgen.params import load_params
-    from cadgen.solids.sweep import FclScene, part_reach
+    from cadgen.sweep.fcl import FclScene, part_reach
 
     params = load_params(PARAMS)
     run = _Build(params, ["kinematics", "metrics", "cam", "parts"], None)

@@ -38,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from cadgen.gear_pairs import PitchPair, generate_pair
-from cadgen.meshing import meshing_check
-from cadgen.teeth import (ToothSystem, gear_outline, rack_space_boundary,
+from cadgen.gears.pairs import PitchPair, generate_pair
+from cadgen.gears.meshing import meshing_check
+from cadgen.gears.teeth import (ToothSystem, gear_outline, rack_space_boundary,
                           rack_tooth_outline, simulated_rack_cut)
 from kinematics.pitch_curves import polar_perimeter, solve_closure
 
@@ -322,7 +322,7 @@ def flank_accuracy(case, repeat: int):
 def dxf_tolerance(case, repeat: int):
     import ezdxf
 
-    from cadgen.export_dxf import write_gear_dxf
+    from cadgen.export.dxf import write_gear_dxf
 
     generated = generate_pair(case["pair"], TEETH, system=SYSTEM, flank_points=DXF_FLANKS)
     profile = generated.profiles[0]

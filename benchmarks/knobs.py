@@ -34,8 +34,8 @@ def sweep_rows():
     The refinement finds the minimum to round-off at any tolerance; what ``atol`` buys
     is the certificate: the true minimum lies within ``gap`` below the value found.
     """
-    from cadgen.clearances import SWEEP_STEPS
-    from cadgen.solids.sweep import certified_distance
+    from cadgen.pipeline.clearances import SWEEP_STEPS
+    from cadgen.sweep.fcl import certified_distance
 
     from ._paper import sweep_cases
 

@@ -47,7 +47,7 @@ def segments_table(params, mechanism):
     """Rows ``(segments, tube volume err, tube area err, housing volume err, ms)``."""
     import shapely
 
-    from cadgen.housings import housing_circles, planting_shells
+    from cadgen.solids.housings import housing_circles, planting_shells
     from cadgen.solids.extrude import to_trimesh
     from cadgen.solids.shell import closed_shell
 
@@ -86,8 +86,8 @@ def segments_table(params, mechanism):
 
 def flank_table(params, mechanism):
     """Rows ``(gear, flank points, volume err, area err, triangles, seconds)``."""
-    from cadgen.gear_pairs import circle_pair, generate_pair
-    from cadgen.gear_trains import _system, planting_pair
+    from cadgen.gears.pairs import circle_pair, generate_pair
+    from cadgen.gears.trains import _system, planting_pair
     from cadgen.solids.extrude import to_trimesh
     from cadgen.solids.parts import gear_solid
 

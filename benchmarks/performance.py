@@ -54,8 +54,8 @@ def build_times(root: Path, repeat: int, effects=None) -> dict:
 
 def sweep_table() -> list:
     """``[(clearance, method, minimum, error, poses, seconds)]`` with the build's own bounds."""
-    from cadgen.clearances import SWEEP_ATOL, SWEEP_STEPS
-    from cadgen.solids.sweep import certified_distance, plain_scan
+    from cadgen.pipeline.clearances import SWEEP_ATOL, SWEEP_STEPS
+    from cadgen.sweep.fcl import certified_distance, plain_scan
 
     from ._paper import sweep_cases
 

@@ -16,11 +16,11 @@ _EXPORTS = {
     "load_params": "cadgen.params",
     "validate_text": "cadgen.params",
     "validate_data": "cadgen.params",
-    "run_analysis": "cadgen.analyze",
-    "write_bytes_atomic": "cadgen.atomic",
-    "write_text_atomic": "cadgen.atomic",
-    "staged_directory": "cadgen.atomic",
-    "build": "cadgen.build",
+    "run_analysis": "cadgen.pipeline.analyze",
+    "write_bytes_atomic": "cadgen.export.atomic",
+    "write_text_atomic": "cadgen.export.atomic",
+    "staged_directory": "cadgen.export.atomic",
+    "build": "cadgen.pipeline.build",
 }
 
 __all__ = ["__version__", *_EXPORTS]

@@ -117,11 +117,11 @@ def _cmd_build(args: argparse.Namespace) -> int:
         print(f"{args.file}: {exc}", file=sys.stderr)
         return EXIT_PROBLEMS
 
-    import cadgen.build
-    from cadgen.atomic import OutputDirError
+    import cadgen.pipeline.build
+    from cadgen.export.atomic import OutputDirError
 
     try:
-        result = cadgen.build.build(params, output_root=Path(args.output_dir),
+        result = cadgen.pipeline.build.build(params, output_root=Path(args.output_dir),
                                     effects=args.effects, case=args.case, steps=args.steps,
                                     preset=args.preset)
     except OutputDirError:
@@ -250,7 +250,7 @@ def _check_output_dir(args: argparse.Namespace) -> None:
     """An unusable ``--output-dir`` is an error before any work (build, analyze, batch)."""
     directory = getattr(args, "output_dir", None)
     if directory is not None:
-        from cadgen.atomic import check_output_root
+        from cadgen.export.atomic import check_output_root
 
         check_output_root(directory)
 
@@ -341,7 +341,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         except Exception as error:
             interrupts.stopping = True
             if not interrupts.seen:
-                from cadgen.atomic import OutputDirError
+                from cadgen.export.atomic import OutputDirError
 
                 if isinstance(error, OutputDirError):
                     print(f"cadgen: {error}", file=sys.stderr)

@@ -11,7 +11,7 @@ from kinematics.evaluation import Targets, evaluate_planting
 from kinematics.pitch_curves import LimaconPitchCurve
 from kinematics.planting import PlantingMechanism
 
-from .housings import housing_circles
+from cadgen.solids.housings import housing_circles
 
 __all__ = ["build_mechanism", "targets_of", "evaluate", "pricking_design",
            "pricking_field"]

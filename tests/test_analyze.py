@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from cadgen.analyze import run_analysis
+from cadgen.pipeline.analyze import run_analysis
 from cadgen.params import load_params
 from tests.helpers import REFERENCE
 
@@ -54,12 +54,12 @@ def test_failure_leaves_previous_outputs_untouched(params, tmp_path, monkeypatch
     run_analysis(params, output_root=tmp_path, plots=False, gears=False)
     before = (tmp_path / "xin2024-planter" / "report.json").read_bytes()
 
-    import cadgen.figures
+    import cadgen.pipeline.figures
 
     def broken(*args, **kwargs):
         raise RuntimeError("plotting failed")
 
-    monkeypatch.setattr(cadgen.figures, "build_figures", broken)
+    monkeypatch.setattr(cadgen.pipeline.figures, "build_figures", broken)
     with pytest.raises(RuntimeError):
         run_analysis(params, output_root=tmp_path, gears=False)
     assert (tmp_path / "xin2024-planter" / "report.json").read_bytes() == before

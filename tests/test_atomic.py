@@ -1,4 +1,4 @@
-"""Tests of cadgen.atomic: atomic files and staged output directories."""
+"""Tests of cadgen.export.atomic: atomic files and staged output directories."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import stat
 
 import pytest
 
-import cadgen.atomic
-from cadgen.atomic import staged_directory, write_bytes_atomic, write_text_atomic
+import cadgen.export.atomic
+from cadgen.export.atomic import staged_directory, write_bytes_atomic, write_text_atomic
 
 
 def _names(directory):
@@ -51,7 +51,7 @@ def test_failed_write_leaves_the_old_file_and_no_temporary(tmp_path, monkeypatch
     def broken_replace(src, dst):
         raise OSError("disk full")
 
-    monkeypatch.setattr(cadgen.atomic.os, "replace", broken_replace)
+    monkeypatch.setattr(cadgen.export.atomic.os, "replace", broken_replace)
     with pytest.raises(OSError, match="disk full"):
         write_text_atomic(target, "new")
     assert target.read_text() == "old"
@@ -125,7 +125,7 @@ def test_staged_directory_failed_swap_restores_old_outputs(tmp_path, monkeypatch
             raise OSError("rename refused")
         return real_replace(src, dst)
 
-    monkeypatch.setattr(cadgen.atomic.os, "replace", replace)
+    monkeypatch.setattr(cadgen.export.atomic.os, "replace", replace)
     with pytest.raises(OSError, match="rename refused"):
         with staged_directory(final) as staging:
             (staging / "new.stl").write_text("new")

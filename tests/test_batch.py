@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from cadgen.atomic import staged_directory
+from cadgen.export.atomic import staged_directory
 from cadgen.batch import (
     DEFAULT_BUILD,
     EXIT_FAILED,
@@ -48,7 +48,7 @@ ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "params" / "xin2024-planter.toml"
 KERNEL_A = ROOT / "params" / "kernel-a.toml"
 INVALID = ROOT / "tests" / "invalid" / "missing_key.toml"  # name "bad-example", train.R missing
-FAST = {"effects": ["metrics"]}   # keyword arguments of cadgen.build.build: a fast build
+FAST = {"effects": ["metrics"]}   # keyword arguments of cadgen.pipeline.build.build: a fast build
 
 
 def write_grid(directory: Path, body: str, base: Path = REFERENCE, name: str | None = "r-sweep"):
@@ -76,7 +76,7 @@ def half_written_build(params, output_root, **kwargs):
         with staged_directory(Path(output_root) / params.name) as staging:
             (staging / "report.json").write_text("{")
             raise RuntimeError("engine crashed while writing")
-    from cadgen.build import build
+    from cadgen.pipeline.build import build
 
     return build(params, output_root=output_root, **FAST)
 
@@ -105,7 +105,7 @@ def fault_build(params, output_root, *, pid_dir=None, **kwargs):
             elif number == "004":
                 os._exit(3)
             os.kill(os.getpid(), signal.SIGKILL)
-    from cadgen.build import build
+    from cadgen.pipeline.build import build
 
     return build(params, output_root=output_root, **kwargs)
 

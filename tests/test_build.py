@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-import cadgen.build
-from cadgen.build import build, plan
+import cadgen.pipeline.build
+from cadgen.pipeline.build import build, plan
 from cadgen.cli import EXIT_CHECKS_FAILED, EXIT_OK, main
 from cadgen.params import load_params
 from kinematics.errors import DesignError, Problem
@@ -74,7 +74,7 @@ def test_a_failed_stage_is_reported_its_dependents_skipped_the_rest_written(
     def broken(run):
         raise DesignError([Problem("cam.roller_radius", "synthetic", "the cam stage broke")])
 
-    monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, "cam", broken)
+    monkeypatch.setitem(cadgen.pipeline.build.STAGE_FUNCTIONS, "cam", broken)
     result = build(params, tmp_path, effects=["metrics", "teeth", "cam", "curves", "dxf"])
     stages = {s["stage"]: s for s in result.report["stages"]}
     assert stages["cam"]["status"] == "failed" and "the cam stage broke" in stages["cam"]["message"]
@@ -89,7 +89,7 @@ def test_a_failed_stage_is_reported_its_dependents_skipped_the_rest_written(
 def test_a_failure_while_writing_leaves_the_previous_outputs(params, tmp_path, monkeypatch):
     build(params, tmp_path, effects=["metrics"])
     before = (tmp_path / "xin2024-planter" / "report.json").read_bytes()
-    import cadgen.writers
+    import cadgen.pipeline.writers
 
     def failing(run):
         def write(staging):
@@ -97,7 +97,7 @@ def test_a_failure_while_writing_leaves_the_previous_outputs(params, tmp_path, m
             raise RuntimeError("disk full")
         return [write]
 
-    monkeypatch.setattr(cadgen.writers, "writers_for", failing)
+    monkeypatch.setattr(cadgen.pipeline.writers, "writers_for", failing)
     with pytest.raises(RuntimeError):
         build(params, tmp_path, effects=["metrics", "curves"])
     assert (tmp_path / "xin2024-planter" / "report.json").read_bytes() == before
@@ -165,13 +165,13 @@ def test_sweeps_replace_the_kinematic_estimates_and_keep_them_beside(params):
 
 
 def test_figures_drawn_in_a_forked_worker_are_the_same_bytes(params):
-    from cadgen.figures import _can_fork, build_figures
+    from cadgen.pipeline.figures import _can_fork, build_figures
 
     if not _can_fork():
         pytest.skip("this platform cannot fork")
-    result = cadgen.build._Build(params, ["kinematics", "metrics", "cam"], None)
+    result = cadgen.pipeline.build._Build(params, ["kinematics", "metrics", "cam"], None)
     result.effects, result.case = ["cam"], "field"
-    result.run(cadgen.build.STAGE_FUNCTIONS)
+    result.run(cadgen.pipeline.build.STAGE_FUNCTIONS)
     together = build_figures(result, parallel=True)
     alone = build_figures(result, parallel=False)
     assert list(together) == list(alone) and len(together) == 7
@@ -180,7 +180,7 @@ def test_figures_drawn_in_a_forked_worker_are_the_same_bytes(params):
 
 def test_sweeps_run_beside_the_teeth_give_the_same_clearances(params):
     """With teeth to cut, the sweeps run in a forked worker on a gearless assembly."""
-    from cadgen.figures import _can_fork
+    from cadgen.pipeline.figures import _can_fork
 
     if not _can_fork():
         pytest.skip("this platform cannot fork")

@@ -15,9 +15,9 @@ import shapely
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from cadgen.cam_design import design_cam
+from cadgen.cam.design import design_cam
 from cadgen.design import build_mechanism, evaluate
-from cadgen.build import build
+from cadgen.pipeline.build import build
 from cadgen.params import ParameterError, stage_problems, validate_text
 from kinematics.duckbill import DuckbillLinkage
 from kinematics.errors import DesignError
@@ -284,7 +284,7 @@ def test_unknown_cam_law_is_refused_at_load():
 def test_cam_dxf_is_one_closed_cutting_path_within_the_chord_tolerance(paper, tmp_path):
     import ezdxf
 
-    from cadgen.export_dxf import write_cam_dxf
+    from cadgen.export.dxf import write_cam_dxf
 
     profile = paper[3].profile
     contour, pitch = profile.working_profile(3600), profile.pitch_curve(3600)

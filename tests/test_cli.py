@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 
 import cadgen
-import cadgen.atomic
-import cadgen.feasibility
+import cadgen.export.atomic
+import cadgen.params.feasibility
 from cadgen.cli import (
     CRASH_DIR_VARIABLE,
     EXIT_INTERNAL,
@@ -120,8 +120,8 @@ class _FakeResult:
 
 @pytest.fixture
 def fake_analysis(monkeypatch):
-    """Stand-in for cadgen.build.build, recording its calls; feasibility isolated too."""
-    import cadgen.build
+    """Stand-in for cadgen.pipeline.build.build, recording its calls; feasibility isolated too."""
+    import cadgen.pipeline.build
 
     calls = []
     module = types.SimpleNamespace(fail=None, calls=calls)
@@ -133,8 +133,8 @@ def fake_analysis(monkeypatch):
             raise module.fail
         return _FakeResult()
 
-    monkeypatch.setattr(cadgen.build, "build", build)
-    monkeypatch.setattr(cadgen.feasibility, "design_problems", lambda params: [])
+    monkeypatch.setattr(cadgen.pipeline.build, "build", build)
+    monkeypatch.setattr(cadgen.params.feasibility, "design_problems", lambda params: [])
     return module
 
 
@@ -278,13 +278,13 @@ def test_keyboard_interrupt_exits_130_with_one_line(fake_analysis, tmp_path, cap
 
 
 def test_keyboard_interrupt_during_a_real_build_leaves_no_folder(tmp_path, monkeypatch, capsys):
-    import cadgen.build
+    import cadgen.pipeline.build
 
     def interrupted(run):
         raise KeyboardInterrupt
 
     # the solids stage is interrupted after the metrics and cam ran: nothing may be written
-    monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, "parts", interrupted)
+    monkeypatch.setitem(cadgen.pipeline.build.STAGE_FUNCTIONS, "parts", interrupted)
     out = tmp_path / "out"
     (out / "xin2024-planter").mkdir(parents=True)
     (out / "xin2024-planter" / "previous.txt").write_text("kept")
@@ -317,13 +317,13 @@ def _unusable_output_dirs(tmp_path):
 def test_unusable_output_dir_exits_2_before_any_work(case, command, tmp_path, monkeypatch,
                                                      capsys):
     import cadgen.batch
-    import cadgen.build
+    import cadgen.pipeline.build
     import cadgen.params
 
     def no_work(*args, **kwargs):
         pytest.fail("work started although the output directory cannot be used")
 
-    for module, name in ((cadgen.build, "build"), (cadgen.params, "load_params"),
+    for module, name in ((cadgen.pipeline.build, "build"), (cadgen.params, "load_params"),
                          (cadgen.batch, "run_batch"), (cadgen.batch, "expand_grid")):
         monkeypatch.setattr(module, name, no_work)
     directory, reason = _unusable_output_dirs(tmp_path)[case]
@@ -374,13 +374,13 @@ def test_unwritable_output_dir_is_found_by_trying(tmp_path, capsys, fake_analysi
 
 
 def test_design_folder_that_is_a_file_is_refused_before_any_stage(tmp_path, monkeypatch, capsys):
-    import cadgen.build
+    import cadgen.pipeline.build
 
     def no_stage(run):
         pytest.fail("a stage ran")
 
-    for stage in list(cadgen.build.STAGE_FUNCTIONS):
-        monkeypatch.setitem(cadgen.build.STAGE_FUNCTIONS, stage, no_stage)
+    for stage in list(cadgen.pipeline.build.STAGE_FUNCTIONS):
+        monkeypatch.setitem(cadgen.pipeline.build.STAGE_FUNCTIONS, stage, no_stage)
     (tmp_path / "xin2024-planter").write_text("a file where the outputs would go")
     assert main(["build", str(REFERENCE), "--output-dir", str(tmp_path)]) == EXIT_PROBLEMS
     (line,) = capsys.readouterr().err.splitlines()
@@ -390,15 +390,15 @@ def test_design_folder_that_is_a_file_is_refused_before_any_stage(tmp_path, monk
 
 
 def test_library_build_raises_output_dir_error(tmp_path):
-    from cadgen.atomic import OutputDirError
-    from cadgen.build import build
+    from cadgen.export.atomic import OutputDirError
+    from cadgen.pipeline.build import build
     from cadgen.params import load_params
 
     with pytest.raises(OutputDirError, match="is a file") as caught:
         (tmp_path / "f").write_text("")
         build(load_params(REFERENCE), tmp_path / "f" / "out", effects=["metrics"])
     assert caught.value.directory == tmp_path / "f" / "out"
-    assert isinstance(caught.value, cadgen.atomic.MechanismError)
+    assert isinstance(caught.value, cadgen.export.atomic.MechanismError)
 
 
 def test_a_reader_that_goes_away_is_a_quiet_141(monkeypatch, capsys):

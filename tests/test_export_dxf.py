@@ -13,10 +13,10 @@ import pytest
 ezdxf = pytest.importorskip("ezdxf")
 shapely = pytest.importorskip("shapely")
 
-import cadgen.atomic
-import cadgen.export_dxf as export_dxf
-from cadgen.export_dxf import DxfExportError, DxfInputError, DxfSummary, write_gear_dxf, write_train_sheet
-from cadgen.gear_profile import GearProfile
+import cadgen.export.atomic
+import cadgen.export.dxf as export_dxf
+from cadgen.export.dxf import DxfExportError, DxfInputError, DxfSummary, write_gear_dxf, write_train_sheet
+from cadgen.gears.profile import GearProfile
 from kinematics.errors import MechanismError
 
 ACCURACY = 1e-9  # mm: float slack on the chord-tolerance guarantee (coordinates round-trip exactly)
@@ -254,7 +254,7 @@ def test_failed_rename_leaves_nothing(tmp_path, star, monkeypatch, existing):
     if existing:
         target.write_bytes(b"previous contents")
     # The temporary file is fully written, then the rename fails.
-    monkeypatch.setattr(cadgen.atomic.os, "replace", _fail_rename)
+    monkeypatch.setattr(cadgen.export.atomic.os, "replace", _fail_rename)
     with pytest.raises(OSError, match="simulated failure"):
         write_gear_dxf(target, star)
     monkeypatch.undo()
@@ -398,7 +398,7 @@ def test_train_sheet_bad_placements(tmp_path, star):
 
 
 def test_import_does_not_load_engines():
-    code = ("import sys, cadgen.export_dxf; "
+    code = ("import sys, cadgen.export.dxf; "
             "loaded = [m for m in ('ezdxf', 'shapely') if m in sys.modules]; "
             "assert not loaded, loaded")
     subprocess.run([sys.executable, "-c", code], check=True)

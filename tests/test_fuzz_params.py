@@ -43,7 +43,7 @@ from hypothesis import strategies as st
 from pydantic import BaseModel
 
 import cadgen.design  # noqa: F401  (imported before warnings become errors in _verdict)
-import cadgen.feasibility  # noqa: F401
+import cadgen.params.feasibility  # noqa: F401
 import cadgen.params
 from cadgen.cli import EXIT_PROBLEMS, main
 from cadgen.params import (

@@ -6,12 +6,12 @@ import pytest
 import shapely
 
 from cadgen.design import build_mechanism, pricking_design
-from cadgen.export_dxf import write_gear_dxf
-from cadgen.gear_pairs import circle_pair, generate_pair
-from cadgen.gear_trains import planting_train, pricking_train, train_report
-from cadgen.meshing import OVERLAP_TOLERANCE, meshing_check
+from cadgen.export.dxf import write_gear_dxf
+from cadgen.gears.pairs import circle_pair, generate_pair
+from cadgen.gears.trains import planting_train, pricking_train, train_report
+from cadgen.gears.meshing import OVERLAP_TOLERANCE, meshing_check
 from cadgen.params import load_params
-from cadgen.teeth import ToothSystem
+from cadgen.gears.teeth import ToothSystem
 from tests.helpers import REFERENCE
 
 

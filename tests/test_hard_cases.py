@@ -53,7 +53,7 @@ def test_tangent_contact_is_a_distance_of_zero_at_the_contact_angle():
     interference range (the solids touch, they do not cross), certified."""
     from test_sweep_fcl import BETA, RHO, carrier_scene, face_box
 
-    from cadgen.solids.sweep import certified_distance
+    from cadgen.sweep.fcl import certified_distance
 
     _, scene = carrier_scene(*face_box(RHO))
     result = certified_distance(scene, lipschitz=RHO, acceleration=RHO, steps=360, atol=1e-9)

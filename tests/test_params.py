@@ -8,7 +8,7 @@ from pathlib import Path
 import pydantic
 import pytest
 
-import cadgen.feasibility
+import cadgen.params.feasibility
 from cadgen.params import (
     MECHANISM_KINDS,
     ParameterError,
@@ -304,7 +304,7 @@ def test_reference_values_equal_the_spec():
 
 
 def test_reference_file_is_feasible():
-    # Runs cadgen.feasibility.design_problems on the paper's design: it must pass.
+    # Runs cadgen.params.feasibility.design_problems on the paper's design: it must pass.
     assert load_params(REFERENCE).name == "xin2024-planter"
 
 
@@ -380,7 +380,7 @@ def test_feasibility_problems_join_the_parameter_error(kind, monkeypatch):
         seen.append(params)
         return [Problem("pitch_curve.b1", "pointed_pitch_curve", "r1 touches zero")]
 
-    monkeypatch.setattr(cadgen.feasibility, "design_problems", fake)
+    monkeypatch.setattr(cadgen.params.feasibility, "design_problems", fake)
     problems = _problems(path)
     assert [(p.path, p.code) for p in problems] == [("pitch_curve.b1", "pointed_pitch_curve")]
     assert len(seen) == 1 and type(seen[0]).__name__ == model
@@ -391,7 +391,7 @@ def test_feasibility_design_error_is_folded_in(kind, monkeypatch):
     def fake(params):
         raise DesignError([Problem("train.R", "tiny_intermediate_radius", "a - r1 is tiny")])
 
-    monkeypatch.setattr(cadgen.feasibility, "design_problems", fake)
+    monkeypatch.setattr(cadgen.params.feasibility, "design_problems", fake)
     assert [p.code for p in _problems(HOOK_CASES[kind][0])] == ["tiny_intermediate_radius"]
 
 
@@ -400,7 +400,7 @@ def test_feasibility_is_skipped_when_the_structure_is_wrong_or_when_asked(kind, 
     path, _, invalid = HOOK_CASES[kind]
     calls = []
     monkeypatch.setattr(
-        cadgen.feasibility, "design_problems", lambda params: calls.append(params) or []
+        cadgen.params.feasibility, "design_problems", lambda params: calls.append(params) or []
     )
     _problems(invalid)
     load_params(path, check_feasibility=False)

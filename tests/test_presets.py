@@ -4,9 +4,9 @@ import math
 
 import pytest
 
-from cadgen.build import build
+from cadgen.pipeline.build import build
 from cadgen.params import load_params, validate_text
-from cadgen.presets import PRESETS, apply_preset
+from cadgen.params.presets import PRESETS, apply_preset
 
 from helpers import REFERENCE, reference_text
 

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from cadgen.analyze import run_analysis
+from cadgen.pipeline.analyze import run_analysis
 from cadgen.params import load_params
-from cadgen.report_html import figure_caption, overall_checks, render_html, write_html
+from cadgen.report.html import figure_caption, overall_checks, render_html, write_html
 from tests.helpers import REFERENCE
 
 VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source",

@@ -13,13 +13,13 @@ import math
 import numpy as np
 import pytest
 
-from cadgen.cam_design import design_cam
+from cadgen.cam.design import design_cam
 from cadgen.design import build_mechanism, evaluate, pricking_design, pricking_field
-from cadgen.gear_trains import planting_train, pricking_train
+from cadgen.gears.trains import planting_train, pricking_train
 from cadgen.params import ParameterError, load_params, validate_text
 from cadgen.params.planting import Gearbox2Envelope
 from cadgen.solids import encloses, load_volume
-from cadgen.solids.export import assembly_bytes, stl_bytes
+from cadgen.export.meshes import assembly_bytes, stl_bytes
 from cadgen.solids.outline import signed_area
 from cadgen.solids.parts import gear_solid
 from cadgen.solids.planting import planting_assembly
@@ -114,7 +114,7 @@ def test_planting_housings_enclose_their_gears_checked_with_booleans(planting):
 def test_a_housing_too_small_for_its_gears_is_reported(planting):
     """Explicit envelope radii 8 mm short at C: the central gear cuts into gearbox 2's wall."""
     params, mechanism, evaluation, cam, train, *_ = planting
-    from cadgen.housings import housing_circles
+    from cadgen.solids.housings import housing_circles
 
     radius_c = next(c.radius for c in housing_circles(params, mechanism)
                     if (c.gearbox, c.point) == ("gearbox2", "C"))

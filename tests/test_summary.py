@@ -1,4 +1,4 @@
-"""Plain-text summaries (cadgen.summary): every section as a report may hold it, None included."""
+"""Plain-text summaries (cadgen.report.summary): every section as a report may hold it, None included."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import json
 
 import pytest
 
-from cadgen.build import build
+from cadgen.pipeline.build import build
 from cadgen.params import load_params
-from cadgen.summary import format_clearances, format_solids, summary_text
+from cadgen.report.summary import format_clearances, format_solids, summary_text
 from tests.helpers import REFERENCE
 
 

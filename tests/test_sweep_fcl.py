@@ -11,7 +11,7 @@ m3d = pytest.importorskip("manifold3d")
 
 from cadgen.solids.errors import SolidInputError  # noqa: E402
 from cadgen.solids.parts import Assembly, Part, planar_transform  # noqa: E402
-from cadgen.solids.sweep import (  # noqa: E402
+from cadgen.sweep.fcl import (  # noqa: E402
     FclScene, certified_distance, instance_pose, part_reach, plain_scan)
 
 REFERENCE = Path(__file__).resolve().parents[1] / "params" / "xin2024-planter.toml"
@@ -202,7 +202,7 @@ HOUSINGS = ("gearbox1", "gearbox2-arm1", "gearbox2-arm2")
 
 @pytest.fixture(scope="module")
 def planting():
-    from cadgen.cam_design import design_cam
+    from cadgen.cam.design import design_cam
     from cadgen.design import build_mechanism, evaluate
     from cadgen.params import load_params
     from cadgen.solids.planting import planting_assembly
@@ -263,7 +263,7 @@ def test_arm_to_arm_distance_is_confirmed_by_dense_scans(planting):
 
 
 def test_housing_ground_clearance_agrees_with_the_envelope_circles(planting):
-    from cadgen.housings import housing_circles
+    from cadgen.solids.housings import housing_circles
 
     params, mechanism, evaluation, assembly = planting
     parts = {part.name: part for part in assembly.parts}

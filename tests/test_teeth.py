@@ -6,7 +6,7 @@ import shapely
 
 from kinematics.arclength import ArcLengthCurve
 from kinematics.pitch_curves import LimaconPitchCurve
-from cadgen.teeth import (CutterChoice, ToothSystem, gear_outline, simulated_rack_cut,
+from cadgen.gears.teeth import (CutterChoice, ToothSystem, gear_outline, simulated_rack_cut,
                           simulated_shaper_cut)
 from tests.conftest import PAPER_LIMACON
 

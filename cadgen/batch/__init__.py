@@ -33,7 +33,7 @@ process, it is a new interpreter (``subprocess``). The design's process leads it
 process group, so the job's SIGKILL to the group also ends the workers the build forks
 (its sweeps and figures); and it watches a pipe from its job, killing its group when the
 job's process dies, so nothing runs on unwatched. The build writes its folder atomically
-(:func:`cadgen.atomic.staged_directory`: a hidden ``.<name>.staging-XXXXXXXX`` folder
+(:func:`cadgen.export.atomic.staged_directory`: a hidden ``.<name>.staging-XXXXXXXX`` folder
 renamed into place at the end), so a failed or killed design leaves ``<name>/`` as it
 was, a previous build's folder included; after a kill or a death its job removes the
 staging folders the build left (and puts back a previous folder set aside for the swap),
@@ -71,11 +71,11 @@ import os
 import sys
 import time
 
-from .grid import DesignJob, GridError, expand_grid, file_jobs, guard_names
-from .isolated import run_design_isolated
-from .run import run_batch
-from .single import DEFAULT_BUILD, run_design
-from .summary import (
+from cadgen.batch.grid import DesignJob, GridError, expand_grid, file_jobs, guard_names
+from cadgen.batch.isolated import run_design_isolated
+from cadgen.batch.run import run_batch
+from cadgen.batch.single import DEFAULT_BUILD, run_design
+from cadgen.batch.summary import (
     EXIT_FAILED,
     EXIT_OK,
     EXIT_PROBLEMS,

@@ -29,7 +29,7 @@ from typing import Any
 
 from kinematics.errors import DesignError, Problem
 
-from .summary import SUMMARY_CSV, SUMMARY_HTML
+from cadgen.batch.summary import SUMMARY_CSV, SUMMARY_HTML
 
 __all__ = ["DesignJob", "GridError", "file_jobs", "expand_grid", "guard_names"]
 

@@ -24,15 +24,15 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from .grid import DesignJob
-from .single import Build, _exception_failure, _resolve_build, _summary, run_design
+from cadgen.batch.grid import DesignJob
+from cadgen.batch.single import Build, _exception_failure, _resolve_build, _summary, run_design
 
 __all__ = ["run_design_isolated"]
 
 _ORPHANED = 70  # exit code of a design's process whose job went away (see _watch_lifeline)
 
 
-#: What cadgen.atomic.staged_directory leaves beside ``<name>`` if its process is killed:
+#: What cadgen.export.atomic.staged_directory leaves beside ``<name>`` if its process is killed:
 #: ``.<name>.staging-XXXXXXXX`` (outputs being written) and ``.<name>.old-XXXXXXXX`` (the
 #: previous outputs, set aside for the swap). The suffix is tempfile.mkdtemp's.
 _STAGED = re.compile(r"\.(?P<name>.+)\.(?P<kind>staging|old)-[a-z0-9_]{8}")

@@ -9,10 +9,10 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
-from .grid import DesignJob
-from .isolated import _clean_staging, run_design_isolated
-from .single import DEFAULT_BUILD, Build, _exception_failure, _summary, run_design
-from .summary import _order
+from cadgen.batch.grid import DesignJob
+from cadgen.batch.isolated import _clean_staging, run_design_isolated
+from cadgen.batch.single import DEFAULT_BUILD, Build, _exception_failure, _summary, run_design
+from cadgen.batch.summary import _order
 
 __all__ = ["run_batch"]
 

@@ -13,11 +13,11 @@ from typing import Any
 
 from kinematics.errors import DesignError, MechanismError
 
-from .grid import DesignJob
+from cadgen.batch.grid import DesignJob
 
 __all__ = ["DEFAULT_BUILD", "run_design"]
 
-DEFAULT_BUILD = "cadgen.build:build"
+DEFAULT_BUILD = "cadgen.pipeline.build:build"
 """The build each design runs unless told otherwise: ``"module:function"``, called as
 ``build(params, output_root=Path, **build_kwargs)``; it returns an object with
 ``report`` (dict) and ``output_dir`` (and optionally ``files``), or the report dict."""

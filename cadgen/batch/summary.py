@@ -167,7 +167,7 @@ def summary_html(summaries: Sequence[Mapping], title: str = "Batch summary") -> 
 
 def write_summary(summaries: Sequence[dict], output_root: str | os.PathLike) -> tuple[Path, Path]:
     """Write ``batch-summary.csv`` and ``.html`` atomically under ``output_root``; their paths."""
-    from ..atomic import write_text_atomic
+    from cadgen.export.atomic import write_text_atomic
 
     root = Path(output_root)
     root.mkdir(parents=True, exist_ok=True)

@@ -58,7 +58,7 @@ numbers once, at the point's index (``trajectory.points.3``: ``wrong_type`` for 
 wrong shape or a non-number item, ``not_finite`` for nan or inf); too few points at
 the array itself (``trajectory.points``, ``out_of_range``).
 
-Once the file is structurally valid, :func:`cadgen.feasibility.design_problems`
+Once the file is structurally valid, :func:`cadgen.params.feasibility.design_problems`
 adds the problems that need the kinematic model (their codes are its own). Those of
 one build stage (the duckbill linkage and cam timing: stage ``cam``) do not refuse
 the file: they come back attached to the parameters (:func:`stage_problems`) and a
@@ -75,8 +75,8 @@ are re-exported here: import them from :mod:`cadgen.params`.
 
 from __future__ import annotations
 
-from ._tables import MAX_MAGNITUDE, NAME_PATTERN
-from .loading import (
+from cadgen.params._tables import MAX_MAGNITUDE, NAME_PATTERN
+from cadgen.params.loading import (
     MECHANISM_KINDS,
     DesignParameters,
     ParameterError,
@@ -85,7 +85,7 @@ from .loading import (
     validate_data,
     validate_text,
 )
-from .planting import (
+from cadgen.params.planting import (
     CLOSURE_RTOL_RANGE,
     MAX_TEETH,
     MIN_TEETH,
@@ -102,7 +102,7 @@ from .planting import (
     ResolutionParameters,
     TrainParameters,
 )
-from .pricking import (
+from cadgen.params.pricking import (
     EQUAL_PERIMETER,
     INCLINATION_MAX_DEG,
     INVERSE_GRID_RANGE,
@@ -117,9 +117,9 @@ from .pricking import (
     SplitExponent,
     TrajectoryParameters,
 )
-from .cam import CamParameters, CamTimingParameters, DuckbillParameters, LeverParameters
-from .cutting import CuttingParameters
-from .solids import MIN_WALL, GroundParameters, ShellParameters, SolidsParameters
+from cadgen.params.cam import CamParameters, CamTimingParameters, DuckbillParameters, LeverParameters
+from cadgen.params.cutting import CuttingParameters
+from cadgen.params.solids import MIN_WALL, GroundParameters, ShellParameters, SolidsParameters
 
 __all__ = [
     "ParameterError",

@@ -27,7 +27,7 @@ from pydantic_core import PydanticCustomError
 
 from kinematics.errors import Problem
 
-from ._tables import NAME_MAX_LENGTH
+from cadgen.params._tables import NAME_MAX_LENGTH
 
 __all__ = [
     "_problems_error",

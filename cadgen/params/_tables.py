@@ -72,7 +72,7 @@ class _Table(BaseModel):
                                  f"{label} = {shown} is out of range: no parameter is larger "
                                  f"than {MAX_MAGNITUDE:g} in magnitude"))
         if problems:
-            from ._problems import _problems_error  # _problems imports this module
+            from cadgen.params._problems import _problems_error  # _problems imports this module
 
             raise _problems_error(problems)
         return value

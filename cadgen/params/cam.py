@@ -13,7 +13,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from ._tables import _Table
+from cadgen.params._tables import _Table
 
 __all__ = ["CamParameters", "DuckbillParameters", "LeverParameters", "CamTimingParameters"]
 

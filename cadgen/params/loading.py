@@ -5,13 +5,13 @@
 one :class:`ParameterError` that lists every problem found. The file is validated
 against :data:`DesignParameters`, the union of the mechanism kinds told apart by
 ``mechanism``. Once the file is structurally valid,
-:func:`cadgen.feasibility.design_problems` adds the problems that need the kinematic
+:func:`cadgen.params.feasibility.design_problems` adds the problems that need the kinematic
 model; it is imported inside the call, so parsing alone (and ``cadgen --help``) does
 not pay for numpy and scipy. Validation never writes anything.
 
 A problem that belongs to one build stage (``Problem.stage``, e.g. the duckbill
 linkage to ``"cam"``) does not refuse the file on its own: the parameters come back
-with it attached (:func:`stage_problems`), and :func:`cadgen.build.build` makes it an
+with it attached (:func:`stage_problems`), and :func:`cadgen.pipeline.build.build` makes it an
 error when the scene runs that stage and a warning otherwise. A file with other
 problems is refused with all of them, the staged ones among them.
 """
@@ -29,7 +29,7 @@ from pydantic import Field, TypeAdapter, ValidationError
 
 from kinematics.errors import DesignError, Problem
 
-from ._problems import (
+from cadgen.params._problems import (
     _describe,
     _int_text,
     _label,
@@ -37,8 +37,8 @@ from ._problems import (
     _table_name,
     _union_members,
 )
-from .planting import PlantingParameters
-from .pricking import PrickingParameters
+from cadgen.params.planting import PlantingParameters
+from cadgen.params.pricking import PrickingParameters
 
 __all__ = [
     "ParameterError",
@@ -125,7 +125,7 @@ def _too_long_integers(data: Mapping[str, Any]) -> list[Problem]:
 def _feasibility_problems(params: Any) -> list[Problem]:
     # Imported here: the kinematic checks pull in numpy/scipy, which a caller that
     # only parses (or prints --help) should not pay for.
-    from cadgen.feasibility import design_problems
+    from cadgen.params.feasibility import design_problems
 
     try:
         return list(design_problems(params))
@@ -145,7 +145,7 @@ def validate_data(
     source : str, optional
         Where the data came from, for the error message.
     check_feasibility : bool, default True
-        Also run :func:`cadgen.feasibility.design_problems` once the structure is
+        Also run :func:`cadgen.params.feasibility.design_problems` once the structure is
         valid (it needs the kinematic model).
 
     Returns

@@ -3,7 +3,7 @@
 Tables ``[pitch_curve]``, ``[train]``, ``[planter]``, ``[field]`` and the optional
 ``[housing]``, ``[targets]``, ``[resolution]``; :class:`PlantingParameters` holds them
 all. Only rules that need no kinematics are checked here (``2*e2`` whole, no repeated
-plant spacing); :func:`cadgen.feasibility.design_problems` judges the rest.
+plant spacing); :func:`cadgen.params.feasibility.design_problems` judges the rest.
 """
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ from typing import Annotated, Literal, Union
 from pydantic import BeforeValidator, Field, field_validator
 from pydantic_core import PydanticCustomError
 
-from .cam import CamParameters
-from .cutting import CuttingParameters
-from .scene import SceneParameters
-from .solids import GroundParameters, ShellParameters, SolidsParameters
-from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
+from cadgen.params.cam import CamParameters
+from cadgen.params.cutting import CuttingParameters
+from cadgen.params.scene import SceneParameters
+from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
+from cadgen.params._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
     "LimaconParameters",

@@ -16,11 +16,11 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import BeforeValidator, Field, ValidationInfo, field_validator
 from pydantic_core import PydanticCustomError
 
-from ._problems import _close_keys, _describe, _problems_error, _show
-from .cutting import CuttingParameters
-from .scene import SceneParameters
-from .solids import GroundParameters, ShellParameters, SolidsParameters
-from ._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
+from cadgen.params._problems import _close_keys, _describe, _problems_error, _show
+from cadgen.params.cutting import CuttingParameters
+from cadgen.params.scene import SceneParameters
+from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
+from cadgen.params._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
     "TrajectoryParameters",

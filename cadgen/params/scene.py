@@ -1,6 +1,6 @@
 """The scene: the operating case and the effects a build evaluates (the optional ``[scene]`` table).
 
-A build runs exactly the stages its effects need (see :mod:`cadgen.build`); a
+A build runs exactly the stages its effects need (see :mod:`cadgen.pipeline.build`); a
 scene asking only for ``metrics`` generates no teeth, builds no solids and never
 imports fcl. Left out, the scene is the field run with every effect.
 """
@@ -11,7 +11,7 @@ from typing import Annotated, Literal
 
 from pydantic import BeforeValidator, Field, field_validator
 
-from ._tables import _list_to_tuple, _no_repeats, _Table
+from cadgen.params._tables import _list_to_tuple, _no_repeats, _Table
 
 __all__ = ["EFFECTS", "CASES", "Effect", "SceneParameters"]
 
@@ -36,7 +36,7 @@ class SceneParameters(_Table):
         EFFECTS, min_length=1, description="effects to evaluate (default: every one)")
 
     preset: Literal["draft", "standard", "fine"] = Field(
-        "standard", description='accuracy preset: "draft", "standard" or "fine" (see cadgen.presets)')
+        "standard", description='accuracy preset: "draft", "standard" or "fine" (see cadgen.params.presets)')
 
     @field_validator("effects")
     @classmethod

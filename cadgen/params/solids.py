@@ -15,7 +15,7 @@ from typing import Literal
 from pydantic import Field, field_validator
 from pydantic_core import PydanticCustomError
 
-from ._tables import _Table
+from cadgen.params._tables import _Table
 
 __all__ = ["MIN_WALL", "ShellParameters", "GroundParameters", "SolidsParameters"]
 

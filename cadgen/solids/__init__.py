@@ -27,7 +27,7 @@ Nothing heavy is imported here: manifold3d, trimesh and shapely load on first us
 """
 
 from cadgen.solids.errors import ExportFormatError, SolidError, SolidInputError
-from cadgen.solids.export import (
+from cadgen.export.meshes import (
     AssemblyFormat,
     assembly_bytes,
     load_volume,

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .parts import Part
+from cadgen.solids.parts import Part
 
 __all__ = ["ground_profile", "ground_part"]
 
@@ -45,7 +45,7 @@ def ground_profile(ground, soil_level: float, z_range, ridge_centre: float) -> n
 def ground_part(ground, soil_level: float, x_range, z_range, *, ridge_centre: float,
                 segments: int) -> Part:
     """The ground slab over ``x_range`` (+ margin) as a :class:`Part` fixed to the world."""
-    from .extrude import extrude
+    from cadgen.solids.extrude import extrude
 
     profile = ground_profile(ground, soil_level, z_range, ridge_centre)
     x0, x1 = x_range[0] - ground.margin, x_range[1] + ground.margin

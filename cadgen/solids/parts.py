@@ -65,7 +65,7 @@ class Part:
     def mesh(self):
         """The trimesh of the solid (converted once; watertight and positive, or SolidError)."""
         if self._mesh is None:
-            from .extrude import to_trimesh
+            from cadgen.solids.extrude import to_trimesh
 
             self._mesh = to_trimesh(self.solid, self.name)
         return self._mesh
@@ -100,9 +100,9 @@ def gear_solid(profile, face_width: float, segments: int, path: str, chord_toler
     The outline is the one the gear's DXF holds (thinned to ``chord_tolerance``), so
     the STL and the cutting file describe the same part.
     """
-    from ..export_dxf import thinned_outline
-    from .extrude import extrude
-    from .outline import circle
+    from cadgen.export.dxf import thinned_outline
+    from cadgen.solids.extrude import extrude
+    from cadgen.solids.outline import circle
 
     holes = [circle(profile.bore_radius, segments, profile.centre)] if profile.bore_radius > 0 else []
     outline = thinned_outline(profile, chord_tolerance)

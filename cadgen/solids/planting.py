@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .parts import Assembly, Part, gear_solid, planar_transform
+from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
 
 __all__ = ["PlantingLayout", "planting_assembly"]
 
@@ -125,7 +125,7 @@ def body_poses(mechanism, layout):
 # ------------------------------------------------------------------ parts
 def _gear_parts(params, mechanism, train, layout, segments):
     """Every gear of both trains, in its body, turning with the carrier angle."""
-    from ..gear_trains import _placements
+    from cadgen.gears.trains import _placements
 
     n = mechanism.n
     F = mechanism.intermediate_rotation
@@ -172,7 +172,7 @@ def _gear_parts(params, mechanism, train, layout, segments):
 
 
 def _housing_parts(params, mechanism, circles, shells, layout, segments):
-    from .shell import closed_shell
+    from cadgen.solids.shell import closed_shell
 
     a, r = mechanism.centre_distance, mechanism.r
     radius = {(c.gearbox, c.point): c.radius for c in circles}
@@ -202,9 +202,9 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments):
 
 
 def _cam_part(params, mechanism, cam_design, layout, segments):
-    from ..export_dxf import thinned_contour
-    from .extrude import extrude
-    from .outline import circle
+    from cadgen.export.dxf import thinned_contour
+    from cadgen.solids.extrude import extrude
+    from cadgen.solids.outline import circle
 
     points = params.cam.profile_points
     bore = params.cam.bore_diameter / 2
@@ -226,8 +226,8 @@ def _planter_parts(params, cam_design, layout, segments):
     """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades."""
     import manifold3d as m3d
 
-    from .extrude import extrude
-    from .outline import hull_of_circles
+    from cadgen.solids.extrude import extrude
+    from cadgen.solids.outline import hull_of_circles
 
     planter = params.planter
     L1, L2, wall = planter.L1, planter.L2, planter.shell_wall
@@ -305,8 +305,8 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float) -
     :class:`~cadgen.solids.shell.Housing` records of gearbox 1 and gearbox 2 (for
     the enclosure checks).
     """
-    from ..housings import housing_circles, planting_shells
-    from .ground import ground_part
+    from cadgen.solids.housings import housing_circles, planting_shells
+    from cadgen.solids.ground import ground_part
 
     segments = params.solids.segments_per_circle
     shells = planting_shells(params, mechanism)

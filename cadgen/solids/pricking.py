@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from .parts import Assembly, Part, gear_solid, planar_transform
+from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
 
 __all__ = ["pricking_assembly"]
 
@@ -52,8 +52,8 @@ def pricking_assembly(params, design, train, field):
     """
     from kinematics.pricking_field import needle_geometry
 
-    from .ground import ground_part
-    from .shell import closed_shell
+    from cadgen.solids.ground import ground_part
+    from cadgen.solids.shell import closed_shell
 
     segments = params.solids.segments_per_circle
     link = design.linkage
@@ -97,7 +97,7 @@ def pricking_assembly(params, design, train, field):
     layers = [gap, 2 * gap + faces[0]]
     parts, discs = [], {}
     if train is not None and train.stages:
-        from ..gear_trains import _placements
+        from cadgen.gears.trains import _placements
 
         stage_of = {}
         for index, stage in enumerate(train.stages):
@@ -155,8 +155,8 @@ def _rocker_and_needle(params, link, needle, *, z0, segments):
     """The rocker bar from B along +x (l1) and the needle from its end, perpendicular, to D."""
     import manifold3d as m3d
 
-    from .extrude import extrude
-    from .outline import hull_of_circles
+    from cadgen.solids.extrude import extrude
+    from cadgen.solids.outline import hull_of_circles
 
     linkage = params.linkage
     half = linkage.rocker_width / 2

@@ -75,7 +75,7 @@ def enclosure_checks(assembly, housings: dict) -> list:
 
 def solids_report(outcome: SolidsOutcome) -> dict:
     """Mass properties per part, the enclosure checks and the assembly's pose (report.json)."""
-    from .mass import mass_properties
+    from cadgen.solids.mass import mass_properties
 
     parts = []
     total = 0.0
@@ -104,7 +104,7 @@ def solids_report(outcome: SolidsOutcome) -> dict:
 
 def write_solids(outcome: SolidsOutcome, staging) -> list:
     """Write ``solids/<part>.stl`` and ``solids/assembly.<glb|3mf>``; return the relative paths."""
-    from .export import assembly_bytes, stl_bytes
+    from cadgen.export.meshes import assembly_bytes, stl_bytes
 
     folder = staging / "solids"
     folder.mkdir()

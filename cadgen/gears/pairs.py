@@ -22,8 +22,8 @@ import shapely.errors
 from kinematics.arclength import ArcLengthCurve
 from kinematics.errors import DesignError
 
-from .gear_profile import GearProfile
-from .teeth import CutterChoice, ToothSystem, gear_outline
+from cadgen.gears.profile import GearProfile
+from cadgen.gears.teeth import CutterChoice, ToothSystem, gear_outline
 
 __all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "generate_gear",
            "mating_phase", "circle_pair", "MIN_SHAPER_TEETH"]

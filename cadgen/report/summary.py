@@ -30,7 +30,7 @@ def summary_text(report: dict) -> str:
     """Everything a person reads after a build: metrics, gears, cam, solids, sweeps, stages."""
     sections = []
     if report["mechanism"] == "pricking" and "linkage" in report:
-        from .pricking_report import pricking_summary
+        from cadgen.report.pricking import pricking_summary
 
         sections.append(pricking_summary(report))
     elif "metrics" in report:

@@ -21,7 +21,7 @@ def input_hash(params) -> str:
 def _versions() -> dict:
     import scipy
 
-    from . import __version__
+    from cadgen import __version__
 
     return {"cadgen": __version__, "python": platform.python_version(),
             "numpy": np.__version__, "scipy": scipy.__version__}
@@ -119,21 +119,21 @@ def assemble_report(run, set_aside: dict) -> dict:
     values = run.values
     ok = {r.stage for r in run.records if r.status == "ok"}
     if params.mechanism == "pricking" and {"kinematics", "metrics"} <= ok:
-        from .pricking_report import pricking_report
+        from cadgen.report.pricking import pricking_report
 
         report.update(pricking_report(params, values["kinematics"], values["metrics"]))
     elif params.mechanism == "planting" and "metrics" in ok:
         report.update(report_dict(params, values["kinematics"], values["metrics"], run.case))
     if "teeth" in ok:
-        from .gear_trains import train_report
+        from cadgen.gears.trains import train_report
 
         report["gear_train"] = train_report(values["teeth"])
     if "cam" in ok:
-        from .cam_design import cam_section
+        from cadgen.cam.design import cam_section
 
         report["cam"] = cam_section(values["cam"])
     if "parts" in ok:
-        from .solids.stage import solids_report
+        from cadgen.solids.stage import solids_report
 
         report["solids"] = solids_report(values["parts"])
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}

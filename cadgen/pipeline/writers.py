@@ -1,7 +1,7 @@
 """The files a build writes, each from the stages that ran and the effects asked for.
 
 Each writer takes the staging folder and returns the paths it wrote, relative
-to it (see :func:`cadgen.build.build`, which runs them inside the staged,
+to it (see :func:`cadgen.pipeline.build.build`, which runs them inside the staged,
 atomic output folder).
 """
 
@@ -27,14 +27,14 @@ def writers_for(run) -> list:
         if "cam" in ok and run.values["cam"].cuttable:
             writers.append(lambda staging: _write_cam(run, staging))
     if "stl" in effects and "parts" in ok:
-        from .solids.stage import write_solids
+        from cadgen.solids.stage import write_solids
 
         writers.append(lambda staging: write_solids(run.values["parts"], staging))
     return writers
 
 
 def _write_gears(run, staging):
-    from .gear_trains import write_train_files
+    from cadgen.gears.trains import write_train_files
 
     (staging / "gears").mkdir()
     return [f"gears/{Path(path).name}" for path in
@@ -43,7 +43,7 @@ def _write_gears(run, staging):
 
 
 def _write_cam(run, staging):
-    from .export_dxf import write_cam_dxf
+    from cadgen.export.dxf import write_cam_dxf
 
     params, design = run.params, run.values["cam"]
     points = params.cam.profile_points
@@ -79,7 +79,7 @@ def _pitch_tables(run) -> dict:
         v = np.linspace(0.0, design.motion.period, CURVE_SAMPLES, endpoint=False)
         gears = design.cycle_functions()[0]   # from the outer dead centre, as the train
     else:
-        from .gear_trains import planting_pair
+        from cadgen.gears.trains import planting_pair
 
         pair = planting_pair(run.values["kinematics"])
         v = np.linspace(0.0, 2 * np.pi, CURVE_SAMPLES, endpoint=False)

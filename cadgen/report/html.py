@@ -796,7 +796,7 @@ def write_html(report: dict, figures: dict[str, bytes] | None,
     Path
         The written file; its directory must exist.
     """
-    from .atomic import write_text_atomic
+    from cadgen.export.atomic import write_text_atomic
 
     return write_text_atomic(path, render_html(report, figures))
 

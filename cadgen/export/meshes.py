@@ -18,7 +18,7 @@ GLB
     appearance, by UUIDs derived from the model's content, and the zip is written
     again with the same entries, order, compression and timestamps.
 
-File writers go through :func:`cadgen.atomic.write_bytes_atomic`. trimesh is
+File writers go through :func:`cadgen.export.atomic.write_bytes_atomic`. trimesh is
 imported inside the functions.
 """
 
@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cadgen.atomic import write_bytes_atomic
+from cadgen.export.atomic import write_bytes_atomic
 from cadgen.solids.errors import ExportFormatError, SolidInputError
 
 __all__ = [

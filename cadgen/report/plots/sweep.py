@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .plots import _figure, _png
+from cadgen.report.plots.planting import _figure, _png
 
 __all__ = ["clearance_figure"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plots import _figure, _png
+from cadgen.report.plots.planting import _figure, _png
 from kinematics.planar import unit as _unit
 
 __all__ = ["pricking_figures"]

@@ -1,6 +1,6 @@
 """`run_analysis`: the library entry of earlier releases, now a build with chosen effects.
 
-``cadgen analyze`` is ``cadgen build`` (see :mod:`cadgen.build`); this function
+``cadgen analyze`` is ``cadgen build`` (see :mod:`cadgen.pipeline.build`); this function
 keeps its switches for callers that turn whole parts of the pipeline on or off.
 """
 
@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .build import BuildResult, build
-from .report_build import input_hash, report_dict
-from .summary import format_cam, format_gear_table, format_metrics_table, format_solids
+from cadgen.pipeline.build import BuildResult, build
+from cadgen.report.content import input_hash, report_dict
+from cadgen.report.summary import format_cam, format_gear_table, format_metrics_table, format_solids
 
 __all__ = ["run_analysis", "AnalysisResult", "input_hash", "report_dict", "format_metrics_table",
            "format_gear_table", "format_cam", "format_solids"]

@@ -6,7 +6,7 @@ import numpy as np
 
 from kinematics.planar import cross
 
-from .plots import _figure, _fill, _png
+from cadgen.report.plots.planting import _figure, _fill, _png
 
 __all__ = ["assembly_view"]
 

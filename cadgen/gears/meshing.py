@@ -107,7 +107,7 @@ def meshing_check(drive, driven, pair, *, poses: int = 384, window: float | None
     ----------
     drive, driven : GearProfile
         Outlines in their body frames (drive at the origin, driven at ``(a, 0)``).
-    pair : cadgen.gear_pairs.PitchPair
+    pair : cadgen.gears.pairs.PitchPair
         The pitch-curve law: contact functions and rotations over one cycle.
     poses : int
         Poses over the cycle (offset from any tooth symmetry).

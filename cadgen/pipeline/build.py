@@ -144,7 +144,7 @@ class BuildResult:
         return EXIT_OK if self.report.get("passed") else EXIT_CHECKS_FAILED
 
     def summary_text(self) -> str:
-        from .summary import summary_text
+        from cadgen.report.summary import summary_text
 
         text = summary_text(self.report)
         for warning in self.report.get("warnings", []):
@@ -219,7 +219,7 @@ _AHEAD: dict = {}
 def _start_sweeps_ahead(run, functions):
     import multiprocessing
 
-    from .figures import _can_fork
+    from cadgen.pipeline.figures import _can_fork
 
     sweeps = [s for s in SWEEP_STAGES if s in run.stages]
     if not sweeps or "teeth" not in run.stages or not _can_fork() \
@@ -256,10 +256,10 @@ def _sweeps_ahead() -> dict:
 def _kinematics(run):
     params = run.params
     if params.mechanism == "pricking":
-        from .design import pricking_design
+        from cadgen.design import pricking_design
 
         return pricking_design(params)
-    from .design import build_mechanism
+    from cadgen.design import build_mechanism
 
     mechanism = build_mechanism(params)
     mechanism.closure   # the closure is solved here, inside its stage
@@ -269,16 +269,16 @@ def _kinematics(run):
 def _metrics(run):
     params = run.params
     if params.mechanism == "pricking":
-        from .design import pricking_field
+        from cadgen.design import pricking_field
 
         return pricking_field(params, run.values["kinematics"])
-    from .design import evaluate
+    from cadgen.design import evaluate
 
     return evaluate(params, run.values["kinematics"], steps=run.steps)
 
 
 def _teeth(run):
-    from .gear_trains import planting_train, pricking_train
+    from cadgen.gears.trains import planting_train, pricking_train
 
     if run.params.mechanism == "pricking":
         return pricking_train(run.params, run.values["kinematics"])
@@ -286,7 +286,7 @@ def _teeth(run):
 
 
 def _cam(run):
-    from .cam_design import design_cam
+    from cadgen.cam.design import design_cam
 
     return design_cam(run.params, run.values["kinematics"], run.values["metrics"].events)
 
@@ -296,17 +296,17 @@ def _gearless_parts(run):
 
 
 def _parts(run, gears: bool = True):
-    from .solids.stage import solids_outcome
+    from cadgen.solids.stage import solids_outcome
 
     params = run.params
     train = run.values.get("teeth") if gears and run.status("teeth") == "ok" else None
     if params.mechanism == "pricking":
-        from .solids.pricking import pricking_assembly
+        from cadgen.solids.pricking import pricking_assembly
 
         assembly, housings = pricking_assembly(params, run.values["kinematics"], train,
                                                run.values["metrics"])
         return solids_outcome(params, assembly, housings)
-    from .solids.planting import planting_assembly
+    from cadgen.solids.planting import planting_assembly
 
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
     assembly, housings, _ = planting_assembly(params, run.values["kinematics"], train, cam,
@@ -315,21 +315,21 @@ def _parts(run, gears: bool = True):
 
 
 def _arm_interference(run):
-    from .clearances import arm_interference
+    from cadgen.pipeline.clearances import arm_interference
 
     return arm_interference(run.params, run.values["kinematics"], run.values["parts"],
                             run.values.get("cam"))
 
 
 def _ground_clearance(run):
-    from .clearances import ground_clearance
+    from cadgen.pipeline.clearances import ground_clearance
 
     return ground_clearance(run.params, run.values["kinematics"], run.values["parts"],
                             run.values["metrics"])
 
 
 def _plots(run):
-    from .figures import build_figures
+    from cadgen.pipeline.figures import build_figures
 
     return build_figures(run)
 
@@ -348,7 +348,7 @@ def stage_warnings(params, stages) -> list:
     cadgen.params.ParameterError
         With the stage problems whose stage is in ``stages`` (the build cannot run it).
     """
-    from .params import ParameterError, stage_problems
+    from cadgen.params import ParameterError, stage_problems
 
     problems = stage_problems(params)
     refused = [p for p in problems if p.stage in stages]
@@ -376,21 +376,21 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         Overrides ``resolution.steps_per_revolution`` (planting).
     preset : {"draft", "standard", "fine"}, optional
         Overrides the file's ``scene.preset``: the resolution of every knob the file
-        leaves out (see :mod:`cadgen.presets`).
+        leaves out (see :mod:`cadgen.params.presets`).
 
     Raises
     ------
-    cadgen.atomic.OutputDirError
+    cadgen.export.atomic.OutputDirError
         Before any stage runs, when ``output_root`` cannot take the outputs (a file, a
         read-only or virtual filesystem, an existing ``<output_root>/<name>`` file).
     cadgen.params.ParameterError
         Before any stage runs, when a problem validation found belongs to a stage
         the scene runs (see :func:`stage_warnings`); of other stages, warnings.
     """
-    from .presets import apply_preset
+    from cadgen.params.presets import apply_preset
 
     if output_root is not None:
-        from .atomic import check_output_root
+        from cadgen.export.atomic import check_output_root
 
         check_output_root(output_root, name=params.name)
 
@@ -407,7 +407,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
                                             for path, (value, source) in knobs.items()}}
     run.run(STAGE_FUNCTIONS)
-    from .report_build import assemble_report
+    from cadgen.report.content import assemble_report
 
     report = assemble_report(run, set_aside)
     run.report = report
@@ -417,8 +417,8 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
 
 
 def _write(run, final: Path) -> BuildResult:
-    from .atomic import staged_directory
-    from .writers import writers_for
+    from cadgen.export.atomic import staged_directory
+    from cadgen.pipeline.writers import writers_for
 
     report = run.report
     files = []
@@ -432,7 +432,7 @@ def _write(run, final: Path) -> BuildResult:
                 files.append(f"plots/{name}")
         files.append("report.json")
         if "report" in run.effects:
-            from .report_html import render_html
+            from cadgen.report.html import render_html
 
             (staging / "report.html").write_text(render_html(report, run.figures),
                                                  encoding="utf-8")

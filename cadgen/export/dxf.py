@@ -23,7 +23,7 @@ tolerance of the written polyline. If thinning would make the ring cross itself
 actually used is reported in :class:`DxfSummary`.
 
 Every document passes ``ezdxf``'s audit before it is written, and files are written
-atomically (:func:`cadgen.atomic.write_bytes_atomic`): a failure leaves either the
+atomically (:func:`cadgen.export.atomic.write_bytes_atomic`): a failure leaves either the
 previous file or none, never a partial one. The same input gives byte-identical
 files (fixed creation metadata).
 
@@ -43,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cadgen.atomic import write_bytes_atomic
+from cadgen.export.atomic import write_bytes_atomic
 from kinematics.errors import MechanismError
 
 __all__ = [
@@ -389,7 +389,7 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     ----------
     path : str or path-like
         Target file; its directory must exist. An existing file is replaced atomically.
-    profile : cadgen.gear_profile.GearProfile
+    profile : cadgen.gears.profile.GearProfile
         The gear, in its body frame: ``outline`` (n, 2) and ``pitch_curve`` (m, 2)
         closed, simple, finite; ``module`` > 0; ``bore_radius`` >= 0, the bore
         inside the outline.

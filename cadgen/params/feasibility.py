@@ -15,7 +15,7 @@ from kinematics.pitch_curves import pair_problems
 __all__ = ["design_problems", "CAM_STAGE"]
 
 #: The build stage the duckbill linkage and cam timing checks belong to: a scene that
-#: runs no cam (metrics only) keeps them as warnings (see :func:`cadgen.build.build`).
+#: runs no cam (metrics only) keeps them as warnings (see :func:`cadgen.pipeline.build.build`).
 CAM_STAGE = "cam"
 
 
@@ -38,7 +38,7 @@ def design_problems(params) -> list:
     """
     if params.mechanism == "pricking":
         return _pricking_problems(params)
-    from .design import build_mechanism
+    from cadgen.design import build_mechanism
 
     try:
         mechanism = build_mechanism(params)
@@ -68,7 +68,7 @@ def _cam_problems(params, mechanism) -> list:
     itself are reported, not refused: a designer wants to see the cam that fails)."""
     from kinematics.metrics import plant_events
 
-    from .cam_design import linkage_of, timing_of
+    from cadgen.cam.design import linkage_of, timing_of
 
     problems = []
     try:
@@ -90,7 +90,7 @@ def _cam_problems(params, mechanism) -> list:
 
 def _pricking_problems(params) -> list:
     """Run the inverse design and the field check; their specific errors are the problems."""
-    from .design import pricking_design, pricking_field
+    from cadgen.design import pricking_design, pricking_field
 
     try:
         design = pricking_design(params)

@@ -27,26 +27,26 @@ def figure_jobs(run) -> dict:
     jobs = {}
     if params.mechanism == "pricking":
         if {"kinematics", "metrics"} <= ok:
-            from .plots_pricking import pricking_figure_jobs
+            from cadgen.report.plots.pricking import pricking_figure_jobs
 
             jobs.update(pricking_figure_jobs(params, values["kinematics"], values["metrics"]))
     elif "metrics" in ok:
-        from .plots import planting_figure_jobs
+        from cadgen.report.plots.planting import planting_figure_jobs
 
         jobs.update(planting_figure_jobs(values["kinematics"], values["metrics"]))
     if "teeth" in ok and values["teeth"].stages:
-        from .gear_trains import pair_figure_jobs
+        from cadgen.gears.trains import pair_figure_jobs
 
         jobs.update(pair_figure_jobs(values["teeth"]))
     if "cam" in ok:
-        from .plots_cam import cam_figure_jobs
+        from cadgen.report.plots.cam import cam_figure_jobs
 
         jobs.update(cam_figure_jobs(values["cam"], params.cam.profile_points))
     if "parts" in ok:
         jobs["assembly.png"] = lambda: _assembly(run)
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:
-        from .plots_sweep import clearance_figure
+        from cadgen.report.plots.sweep import clearance_figure
 
         jobs["clearance.png"] = lambda: clearance_figure(sweeps)
     return jobs
@@ -99,7 +99,7 @@ def _draw_worker_jobs() -> dict:
 
 
 def _assembly(run) -> bytes:
-    from .plots_solids import assembly_view
+    from cadgen.report.plots.solids import assembly_view
 
     outcome, params, values = run.values["parts"], run.params, run.values
     angle = outcome.carrier_angle

@@ -18,10 +18,10 @@ import numpy as np
 
 from kinematics.errors import DesignError
 
-from .gear_pairs import PitchPair, circle_pair, generate_pair
-from .housings import circular_module, planting_circular_radii
-from .meshing import meshing_check, relieve_interference
-from .teeth import ToothSystem
+from cadgen.gears.pairs import PitchPair, circle_pair, generate_pair
+from cadgen.solids.housings import circular_module, planting_circular_radii
+from cadgen.gears.meshing import meshing_check, relieve_interference
+from cadgen.gears.teeth import ToothSystem
 
 __all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "pricking_train", "circular_module",
            "write_train_files", "train_report", "pair_figures", "pair_figure_jobs"]
@@ -100,7 +100,7 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
 def _carry(generated):
     """A pair's driven gear, to drive the next mesh: the body angle of one of its tooth
     centres (arc lengths of the two meshes start at different contacts) and the cut gear."""
-    from .gear_pairs import angle_at_arc
+    from cadgen.gears.pairs import angle_at_arc
 
     return (angle_at_arc(generated.curves[1], generated.phases[1]),
             (generated.profiles[1], generated.checks[1], generated.spaces[1]))
@@ -200,7 +200,7 @@ def _placements(train: GearTrain):
 
 def write_train_files(train: GearTrain, folder, chord_tolerance: float) -> list:
     """One DXF per gear and an assembled sheet of the train at the start position."""
-    from .export_dxf import write_gear_dxf, write_train_sheet
+    from cadgen.export.dxf import write_gear_dxf, write_train_sheet
 
     written = []
     for profile, _, _, _ in train.gears:
@@ -259,7 +259,7 @@ def pair_figures(train: GearTrain) -> dict:
 
 
 def _pair_figure(stage) -> bytes:
-    from .plots import _figure, _fill, _png
+    from cadgen.report.plots.planting import _figure, _fill, _png
 
     figure, ax = _figure(8.0, 5.0)
     pair = stage.generated.pair

@@ -80,7 +80,7 @@ def pricking_report(params, design, field) -> dict:
 
 def pricking_summary(report: dict) -> str:
     """Plain-text summary: linkage, gears, field table, findings (a missing number reads n/a)."""
-    from .summary import _number as n
+    from cadgen.report.summary import _number as n
 
     link, gears, check = report["linkage"], report["gears"], report["verification"]
     teeth, modules = gears["teeth"], gears["modules_mm"]

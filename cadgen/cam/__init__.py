@@ -1,0 +1,1 @@
+"""The duckbill cam: its design from the planting events, checks and contour."""

@@ -1,0 +1,1 @@
+"""Gears: cutter envelopes (teeth), profiles, non-circular pairs, trains, meshing check."""

@@ -1,0 +1,1 @@
+"""Figures of a build, one module per subject; matplotlib (Agg) only in here."""
