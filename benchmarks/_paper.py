@@ -16,7 +16,8 @@ def sweep_cases():
     from cadgen.pipeline.build import STAGE_FUNCTIONS, _Build
     from cadgen.pipeline.clearances import ARM_PARTS, _arm_bounds
     from cadgen.params import load_params
-    from cadgen.sweep.fcl import FclScene, part_reach
+    from cadgen.sweep.fcl import FclScene
+    from cadgen.sweep.scene import part_reach
 
     params = load_params(PARAMS)
     run = _Build(params, ["kinematics", "metrics", "cam", "parts"], None)

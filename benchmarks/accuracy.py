@@ -38,7 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from kinematics.clearance import _centre_line, _lowest_of_circles, polyline_distance
-from kinematics.evaluation import default_housing_circles, evaluate_planting
+from cadgen.solids.housings import envelope_circles
+from kinematics.evaluation import evaluate_planting
 from kinematics.pitch_curves import (LimaconPitchCurve, centre_distance_at_nodes, polar_perimeter,
                                      solve_closure)
 from kinematics.planting import PlantingMechanism
@@ -57,7 +58,8 @@ def mechanism():
 
 def refined_metrics(steps):
     m = mechanism()
-    result = evaluate_planting(m, teeth=TEETH, depth=DEPTH, spacings=SPACINGS, steps=steps)
+    result = evaluate_planting(m, teeth=TEETH, depth=DEPTH, spacings=SPACINGS, steps=steps,
+                               housing_circles=envelope_circles(m, m.module(TEETH), 6.0))
     return {(k.key, k.spacing): k.value for k in result.metrics if k.key != "soil_penetrations"}
 
 
@@ -95,7 +97,7 @@ def sampled_metrics(steps):
     out[("arm_distance", None)] = polyline_distance(_centre_line(m, half, 0),
                                                     _centre_line(m, half, 1)).min()
     perimeter = polar_perimeter(m.pitch_curve)
-    circles = default_housing_circles(m, perimeter / (np.pi * TEETH), 6.0)  # tip + 6 mm
+    circles = envelope_circles(m, perimeter / (np.pi * TEETH), 6.0)  # tip + 6 mm
     out[("ground_clearance", None)] = (_lowest_of_circles(m, circles, phi) - soil).min()
     out[("module", None)] = perimeter / (np.pi * TEETH)
     return out

@@ -35,7 +35,7 @@ def sweep_rows():
     is the certificate: the true minimum lies within ``gap`` below the value found.
     """
     from cadgen.pipeline.clearances import SWEEP_STEPS
-    from cadgen.sweep.fcl import certified_distance
+    from cadgen.sweep.search import certified_distance
 
     from ._paper import sweep_cases
 

@@ -55,7 +55,7 @@ def build_times(root: Path, repeat: int, effects=None) -> dict:
 def sweep_table() -> list:
     """``[(clearance, method, minimum, error, poses, seconds)]`` with the build's own bounds."""
     from cadgen.pipeline.clearances import SWEEP_ATOL, SWEEP_STEPS
-    from cadgen.sweep.fcl import certified_distance, plain_scan
+    from cadgen.sweep.search import certified_distance, plain_scan
 
     from ._paper import sweep_cases
 

@@ -11,10 +11,10 @@ Two clearances of the solids, each over the carrier angle, measured in this run:
 * ``housings to ground``: gearbox 1 and both gearbox-2 housings against the soil
   slab, over a turn.
 
-Methods: the certified sweep (:func:`cadgen.sweep.fcl.certified_distance`,
+Methods: the certified sweep (:func:`cadgen.sweep.search.certified_distance`,
 360 screening steps per interval, ``atol`` 1e-6 mm, speed and acceleration
 bounds from the mechanism), the plain 3,600-pose scan
-(:func:`cadgen.sweep.fcl.plain_scan`), and the reference: the certified sweep
+(:func:`cadgen.sweep.search.plain_scan`), and the reference: the certified sweep
 at ``atol`` 1e-10 mm, checked against a dense scan of 2,000 poses 1e-6 rad apart
 round its argument. Errors are against the reference value. Times are wall
 times on one core, best of 3 for the certified sweep, one run otherwise; the
@@ -66,7 +66,7 @@ def arm_bounds(mechanism, parts):
     plus its turn (rate at most ``spin``; ``spin rate + spin^2`` read off the P1
     bound) times its reach from E.
     """
-    from cadgen.sweep.fcl import part_reach
+    from cadgen.sweep.scene import part_reach
 
     closure, rc = mechanism.closure, mechanism.carrier_radii["C"]
     spin = max(abs(1.0 - closure.ratio_min), abs(1.0 - closure.ratio_max))
@@ -79,7 +79,8 @@ def arm_bounds(mechanism, parts):
 
 def cases(mechanism, assembly):
     """``[(label, scene, lipschitz, acceleration, upper)]`` of the two clearances."""
-    from cadgen.sweep.fcl import FclScene, part_reach
+    from cadgen.sweep.fcl import FclScene
+    from cadgen.sweep.scene import part_reach
 
     parts = {part.name: part for part in assembly.parts}
     speed, acceleration = arm_bounds(mechanism, parts)
@@ -100,7 +101,7 @@ def cases(mechanism, assembly):
 
 def measure(label, scene, lipschitz, acceleration, upper, build_seconds):
     """One clearance: every figure of its table rows, as a dict."""
-    from cadgen.sweep.fcl import certified_distance, plain_scan
+    from cadgen.sweep.search import certified_distance, plain_scan
 
     def sweep(atol):
         return certified_distance(scene, lipschitz=lipschitz, acceleration=acceleration,

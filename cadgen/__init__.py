@@ -1,7 +1,19 @@
 """cadgen: from a mechanism parameter file to kinematics, metrics and manufacturable parts.
 
-The public names below are imported on first use (PEP 562), so ``import cadgen``
-and ``cadgen --help`` do not pay for pydantic, numpy or the geometry engines.
+The public API: what a script, the command line, the studio and the optimiser use.
+Everything else is internal and may move. The names below are imported on first use
+(PEP 562), so ``import cadgen`` and ``cadgen --help`` do not pay for pydantic, numpy or
+the geometry engines::
+
+    import cadgen
+
+    params = cadgen.load_params("params/xin2024-planter.toml")   # ParameterError: every problem
+    evaluation = cadgen.evaluate(params)                          # metrics, nothing written
+    for metric in evaluation.metrics:
+        print(metric.label, metric.value, metric.passed)
+    result = cadgen.build(params, output_root="outputs")          # the files, atomically
+    print(result.summary_text())
+    raise SystemExit(result.exit_code)
 """
 
 from __future__ import annotations
@@ -9,18 +21,39 @@ from __future__ import annotations
 from importlib import import_module
 
 _EXPORTS = {
+    # errors: every error raised on purpose is a MechanismError; design and parameter
+    # errors are also ValueError, convergence failures ArithmeticError
+    "MechanismError": "kinematics.errors",
+    "DesignError": "kinematics.errors",
+    "ConvergenceError": "kinematics.errors",
+    "Problem": "kinematics.errors",
     "ParameterError": "cadgen.params",
-    "PlantingParameters": "cadgen.params",
-    "DesignParameters": "cadgen.params",
-    "MECHANISM_KINDS": "cadgen.params",
+    "OutputDirError": "cadgen.export.atomic",
+    # parameter files
     "load_params": "cadgen.params",
     "validate_text": "cadgen.params",
     "validate_data": "cadgen.params",
-    "run_analysis": "cadgen.pipeline.analyze",
+    "stage_problems": "cadgen.params",
+    "PlantingParameters": "cadgen.params",
+    "DesignParameters": "cadgen.params",
+    "MECHANISM_KINDS": "cadgen.params",
+    "STEPS_PER_REVOLUTION_RANGE": "cadgen.params",
+    "EFFECTS": "cadgen.params.scene",
+    # evaluating a design (nothing written) and building it (files written)
+    "evaluate": "cadgen.design",
+    "build": "cadgen.pipeline.build",
+    "BuildResult": "cadgen.pipeline.build",
+    "check_output_root": "cadgen.export.atomic",
+    "run_analysis": "cadgen.pipeline.build",
+    # many designs
+    "run_batch": "cadgen.batch",
+    "expand_grid": "cadgen.batch",
+    "file_jobs": "cadgen.batch",
+    "add_batch_arguments": "cadgen.batch",
+    # writing files atomically
     "write_bytes_atomic": "cadgen.export.atomic",
     "write_text_atomic": "cadgen.export.atomic",
     "staged_directory": "cadgen.export.atomic",
-    "build": "cadgen.pipeline.build",
 }
 
 __all__ = ["__version__", *_EXPORTS]

@@ -53,7 +53,7 @@ def _version() -> str:
 
 def _steps(text: str) -> int:
     """argparse type of ``--steps``: an integer in the range the parameter file allows."""
-    from cadgen.params import STEPS_PER_REVOLUTION_RANGE
+    from cadgen import STEPS_PER_REVOLUTION_RANGE
 
     low, high = STEPS_PER_REVOLUTION_RANGE
     try:
@@ -66,8 +66,7 @@ def _steps(text: str) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from cadgen.params import ParameterError, load_params, stage_problems
-    from kinematics.errors import MechanismError
+    from cadgen import MechanismError, ParameterError, load_params, stage_problems
 
     status = EXIT_OK
     for file in args.files:
@@ -92,7 +91,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 def _effects(text: str) -> list:
     """argparse type of ``--effects``: comma-separated effect names, each known."""
-    from cadgen.params.scene import EFFECTS
+    from cadgen import EFFECTS
 
     effects = [e.strip() for e in text.split(",") if e.strip()]
     unknown = [e for e in effects if e not in EFFECTS]
@@ -104,8 +103,7 @@ def _effects(text: str) -> list:
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    from cadgen.params import ParameterError, load_params
-    from kinematics.errors import MechanismError
+    from cadgen import MechanismError, ParameterError, load_params
 
     try:
         params = load_params(args.file)
@@ -117,13 +115,12 @@ def _cmd_build(args: argparse.Namespace) -> int:
         print(f"{args.file}: {exc}", file=sys.stderr)
         return EXIT_PROBLEMS
 
-    import cadgen.pipeline.build
-    from cadgen.export.atomic import OutputDirError
+    import cadgen
+    from cadgen import OutputDirError
 
     try:
-        result = cadgen.pipeline.build.build(params, output_root=Path(args.output_dir),
-                                    effects=args.effects, case=args.case, steps=args.steps,
-                                    preset=args.preset)
+        result = cadgen.build(params, output_root=Path(args.output_dir), effects=args.effects,
+                              case=args.case, steps=args.steps, preset=args.preset)
     except OutputDirError:
         raise                       # main() says it, the same way for every command
     except MechanismError as exc:   # stages report their own failures; this is anything else
@@ -183,7 +180,7 @@ def build_parser() -> argparse.ArgumentParser:
                             ("analyze", "the same as build (the earlier name)")):
         _add_build_arguments(commands.add_parser(name, help=help_text, description=description))
 
-    from cadgen.batch import add_batch_arguments
+    from cadgen import add_batch_arguments
 
     batch = commands.add_parser(
         "batch", help="build many designs (files or a parameter grid), locally or on Dask",
@@ -250,7 +247,7 @@ def _check_output_dir(args: argparse.Namespace) -> None:
     """An unusable ``--output-dir`` is an error before any work (build, analyze, batch)."""
     directory = getattr(args, "output_dir", None)
     if directory is not None:
-        from cadgen.export.atomic import check_output_root
+        from cadgen import check_output_root
 
         check_output_root(directory)
 
@@ -341,7 +338,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         except Exception as error:
             interrupts.stopping = True
             if not interrupts.seen:
-                from cadgen.export.atomic import OutputDirError
+                from cadgen import OutputDirError
 
                 if isinstance(error, OutputDirError):
                     print(f"cadgen: {error}", file=sys.stderr)

@@ -1,4 +1,4 @@
-"""From validated parameters to the kinematic model and its evaluation (planting mechanism)."""
+"""From validated parameters to the kinematic models and their evaluation (both mechanisms)."""
 
 from __future__ import annotations
 
@@ -41,7 +41,16 @@ def targets_of(params) -> Targets:
 
 
 def evaluate(params, mechanism: PlantingMechanism | None = None, steps: int | None = None):
-    """Evaluate every design metric of a validated planting design."""
+    """Evaluate a validated design without writing anything.
+
+    Planting: every design metric against its target, with events and accuracy
+    (:class:`kinematics.evaluation.PlantingEvaluation`). Pricking: the inverse
+    design with its linkage, gears, checks and findings
+    (:class:`kinematics.pricking.PrickingDesign`; its field motion is
+    :func:`pricking_field`).
+    """
+    if params.mechanism == "pricking":
+        return pricking_design(params)
     mechanism = mechanism or build_mechanism(params)
     teeth = params.pitch_curve.teeth
     return evaluate_planting(

@@ -19,8 +19,7 @@ from .metrics import PlantEvents, hole_metrics, plant_events
 from .planting import PlantingMechanism
 from .sweep import Verdict
 
-__all__ = ["Targets", "MetricResult", "PlantingEvaluation", "evaluate_planting",
-           "default_housing_circles"]
+__all__ = ["Targets", "MetricResult", "PlantingEvaluation", "evaluate_planting"]
 
 
 @dataclass(frozen=True)
@@ -84,35 +83,6 @@ class PlantingEvaluation:
         return all(m.passed for m in self.metrics)
 
 
-def default_housing_circles(mechanism: PlantingMechanism, module: float, allowance: float, *,
-                            circular_module: float | None = None,
-                            gearbox1_allowance: float | None = None):
-    """Envelope circles of both gearboxes: the largest gear tip about each axis plus ``allowance``.
-
-    Gearbox 2 holds the non-circular pair and the 1:1 pair: at C the central
-    gear's largest tip radius, at D the larger of the intermediate gear's
-    (``a - min r1`` plus one module) and the circular gear's, at E the planet
-    gear. Gearbox 1 (carrier 1) uses the first train's gear set with converted
-    ratio -1 (sun R, idlers R i12 and R i13, planet R) with the circular
-    module's addendum; the other set is not modelled, so pass explicit radii
-    when it is larger. ``allowance`` (mm) is the housing's clearance plus wall;
-    ``gearbox1_allowance`` defaults to it, ``circular_module`` to ``module``.
-    """
-    closure = mechanism.closure
-    a = closure.centre_distance
-    r_min, r_max = closure.radius_min[1], closure.radius_max[1]
-    R, r = mechanism.R, mechanism.r
-    m_c = module if circular_module is None else circular_module
-    outer1 = allowance if gearbox1_allowance is None else gearbox1_allowance
-    box2 = {"C": r_max + module + allowance,
-            "D": max(a - r_min + module, r + m_c) + allowance,
-            "E": r + m_c + allowance}
-    box1 = {"O": R + m_c + outer1, "A": R * mechanism.i12 + m_c + outer1,
-            "B": R * mechanism.i13 + m_c + outer1, "C": R + m_c + outer1}
-    return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
-            + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])
-
-
 def _searched(key, label, search, target) -> MetricResult:
     """A minimum that must exceed ``target``, judged on its certified gap ``[bound, value]``."""
     verdict = search.verdict_above(target)
@@ -125,8 +95,8 @@ def _deg(x):
 
 
 def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
-                      spacings, carrier_speed_rpm: float = 30.0, housing_circles=None,
-                      housing_wall: float = 6.0, targets: Targets = Targets(),
+                      spacings, housing_circles, carrier_speed_rpm: float = 30.0,
+                      targets: Targets = Targets(),
                       steps: int = tol.STEPS_PER_REVOLUTION,
                       clearance_model=None) -> PlantingEvaluation:
     """Evaluate every design metric of the planting mechanism.
@@ -142,8 +112,9 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         Plant spacings (mm).
     carrier_speed_rpm : float
         Carrier-1 speed for speeds in mm/s.
-    housing_circles : list of HousingCircle, optional
-        Defaults to :func:`default_housing_circles` with ``housing_wall``.
+    housing_circles : list of HousingCircle
+        The gearboxes' envelope circles (the housing code sizes them from the gears:
+        ``cadgen.solids.housings``); the ground clearance is theirs.
     steps : int
         Screening samples per revolution before refinement.
     clearance_model : object, optional
@@ -158,8 +129,7 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
     tip = mechanism.tip_path()
     events = plant_events(tip, depth, steps=steps)
     holes = [hole_metrics(tip, events, float(s), steps=steps) for s in spacings]
-    circles = housing_circles if housing_circles is not None else \
-        default_housing_circles(mechanism, module, housing_wall)  # one allowance for both
+    circles = list(housing_circles)
     model = clearance_model or KinematicClearance(tuple(circles))
     arms = model.arm_distance(mechanism, steps)
     clearance, nearest = model.ground_clearance(mechanism, events.soil_level, steps)

@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from cadgen.pipeline.analyze import run_analysis
+from cadgen.pipeline.build import run_analysis
 from cadgen.params import load_params
 from tests.helpers import REFERENCE
 

@@ -133,7 +133,7 @@ def fake_analysis(monkeypatch):
             raise module.fail
         return _FakeResult()
 
-    monkeypatch.setattr(cadgen.pipeline.build, "build", build)
+    monkeypatch.setattr(cadgen, "build", build)   # the public API the command line calls
     monkeypatch.setattr(cadgen.params.feasibility, "design_problems", lambda params: [])
     return module
 
@@ -236,7 +236,7 @@ def test_internal_error_in_validate_is_3_too(tmp_path, monkeypatch, capsys):
     def broken(path):
         raise TypeError("unsupported operand type(s) for +: 'NoneType' and 'float'")
 
-    monkeypatch.setattr(cadgen.params, "load_params", broken)
+    monkeypatch.setattr(cadgen, "load_params", broken)
     assert main(["validate", str(REFERENCE)]) == EXIT_INTERNAL
     (line,) = capsys.readouterr().err.splitlines()
     assert "internal error: TypeError: unsupported operand" in line

@@ -9,10 +9,17 @@ from kinematics.evaluation import Targets, evaluate_planting
 SPACINGS = (150.0, 185.0, 200.0)
 
 
+def circles(mechanism):
+    """Both gearboxes' envelopes: gear tips plus a 6-mm allowance (clearance and wall)."""
+    from cadgen.solids.housings import envelope_circles
+
+    return envelope_circles(mechanism, mechanism.module(22), 6.0)
+
+
 @pytest.fixture(scope="module")
 def evaluation(paper_mechanism):
     return evaluate_planting(paper_mechanism, teeth=22, depth=35.0, spacings=SPACINGS,
-                             carrier_speed_rpm=30.0)
+                             carrier_speed_rpm=30.0, housing_circles=circles(paper_mechanism))
 
 
 def metric(evaluation, key, spacing=None):
@@ -73,7 +80,7 @@ def test_every_search_is_certified(evaluation):
 def test_targets_decide_pass_and_fail(paper_mechanism):
     strict = Targets(trajectory_height_min=800.0, hole_width_max=5.0)
     result = evaluate_planting(paper_mechanism, teeth=22, depth=35.0, spacings=SPACINGS,
-                               targets=strict)
+                               targets=strict, housing_circles=circles(paper_mechanism))
     assert not metric(result, "trajectory_height").passed
     widths = {m.spacing: m.passed for m in result.metrics if m.key == "hole_width"}
     assert widths == {150.0: True, 185.0: False, 200.0: False}

@@ -16,7 +16,7 @@ shapely = pytest.importorskip("shapely")
 import cadgen.export.atomic
 import cadgen.export.dxf as export_dxf
 from cadgen.export.dxf import DxfExportError, DxfInputError, DxfSummary, write_gear_dxf, write_train_sheet
-from cadgen.gears.profile import GearProfile
+from cadgen.gears.teeth import GearProfile
 from kinematics.errors import MechanismError
 
 ACCURACY = 1e-9  # mm: float slack on the chord-tolerance guarantee (coordinates round-trip exactly)
@@ -231,7 +231,9 @@ def test_tolerance_halved_when_thinning_breaks_simplicity(tmp_path, bay, monkeyp
     # notice, halve the tolerance, and report the one it used.
     plain = shapely.LinearRing(bay.outline).simplify(0.5, preserve_topology=False)
     assert not plain.is_simple
-    monkeypatch.setattr(export_dxf, "_douglas_peucker",
+    import cadgen.geometry.contour
+
+    monkeypatch.setattr(cadgen.geometry.contour, "_douglas_peucker",
                         lambda ring, tolerance: ring.simplify(tolerance, preserve_topology=False))
     summary = write_gear_dxf(tmp_path / "plain.dxf", bay, chord_tolerance=0.5)
     assert summary.chord_tolerance_used == 0.25

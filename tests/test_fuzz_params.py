@@ -609,7 +609,7 @@ def _check_mutant(text, location, what):
 
 
 # Known failures of the kinematic model: a traceback or a numpy warning instead of a
-# problem. They are in kinematics/ and cadgen/feasibility.py, outside the parameter
+# problem. They are in kinematics/ and cadgen/params/feasibility.py, outside the parameter
 # package; the properties skip exactly these values and test_known_kinematics_failures pins
 # each one (none are left; a new one goes here until it is fixed).
 # Location -> the values that fail.

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kinematics.evaluation import default_housing_circles, evaluate_planting
+from cadgen.solids.housings import envelope_circles
+from kinematics.evaluation import evaluate_planting
 from kinematics.pitch_curves import LimaconPitchCurve
 from kinematics.planting import PlantingMechanism
 
@@ -30,7 +31,7 @@ def _metrics(scale: float):
                                   L1=130.0 * scale, L2=190.0 * scale, phi0=np.pi / 2,
                                   phic=np.pi / 2, n=3.0)
     module = mechanism.module(22)
-    circles = default_housing_circles(mechanism, module, 6.0 * scale)
+    circles = envelope_circles(mechanism, module, 6.0 * scale)
     evaluation = evaluate_planting(mechanism, teeth=22, depth=35.0 * scale,
                                    spacings=[150.0 * scale, 200.0 * scale],
                                    housing_circles=circles, steps=720)
@@ -53,7 +54,7 @@ def test_tangent_contact_is_a_distance_of_zero_at_the_contact_angle():
     interference range (the solids touch, they do not cross), certified."""
     from test_sweep_fcl import BETA, RHO, carrier_scene, face_box
 
-    from cadgen.sweep.fcl import certified_distance
+    from cadgen.sweep.search import certified_distance
 
     _, scene = carrier_scene(*face_box(RHO))
     result = certified_distance(scene, lipschitz=RHO, acceleration=RHO, steps=360, atol=1e-9)

@@ -6,7 +6,7 @@ import pytest
 
 from cadgen.pipeline.build import build
 from cadgen.params import load_params, validate_text
-from cadgen.params.presets import PRESETS, apply_preset
+from cadgen.params.scene import PRESETS, apply_preset
 
 from helpers import REFERENCE, reference_text
 

@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from kinematics.errors import ConvergenceError, DesignError
-from kinematics.pricking import _mode_functions, design_pricking, link_lengths
+from kinematics.pricking import design_pricking, link_lengths
+from kinematics.pricking_motion import _mode_functions
 from kinematics.spline import ClosedCurve
 from tests.pricking_cases import KERNEL_A, KERNEL_B
 

@@ -261,7 +261,7 @@ def test_concave_stretches_are_merged_and_read_once(bases):
 def test_the_gap_to_a_dead_centre_circle_is_an_exact_parabola(which):
     # R(u) - R* = R''/2 du^2 + O(du^3): the plain difference loses it below ~1e-5 mm, the
     # chained expansion keeps it down to 1e-7 mm, on whichever side of a nearby knot
-    from kinematics.pricking import _RadialGaps, link_lengths
+    from kinematics.pricking_motion import _RadialGaps, link_lengths
 
     points, _ = point_on_curve_near_dead_centre(KERNEL_B, 5, which, 0.003)
     curve = ClosedCurve(points, 5)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from cadgen.pipeline.analyze import run_analysis
+from cadgen.pipeline.build import run_analysis
 from cadgen.params import load_params
 from cadgen.report.html import figure_caption, overall_checks, render_html, write_html
 from tests.helpers import REFERENCE
@@ -214,6 +214,22 @@ def test_no_external_references(planting, figures):
                     value = attrs[key]
                     assert value.startswith(("#", "data:image/png;base64,")), (tag, value)
                     assert "//" not in value.split(",", 1)[0]
+
+
+@pytest.mark.parametrize("kind", ["planting", "pricking"])
+def test_style_sheet_and_skeleton_come_from_package_data(kind, planting):
+    """report.css and page.html ship beside the module; the page carries the sheet verbatim
+    and no placeholder of the skeleton is left unfilled."""
+    import importlib.resources
+
+    folder = importlib.resources.files("cadgen.report")
+    css = folder.joinpath("report.css").read_text(encoding="utf-8")
+    skeleton = folder.joinpath("page.html").read_text(encoding="utf-8")
+    assert "${css}" in skeleton and "${sections}" in skeleton
+    page = render_html(planting if kind == "planting" else PRICKING)
+    assert page.startswith("<!DOCTYPE html>\n") and page.endswith("</html>\n")
+    assert f"<style>\n{css}</style>" in page
+    assert "${" not in page
 
 
 def test_sweep_section_when_present(planting):

@@ -18,13 +18,14 @@ from cadgen.design import build_mechanism, evaluate, pricking_design, pricking_f
 from cadgen.gears.trains import planting_train, pricking_train
 from cadgen.params import ParameterError, load_params, validate_text
 from cadgen.params.planting import Gearbox2Envelope
-from cadgen.solids import encloses, load_volume
+from cadgen.export.meshes import load_volume
+from cadgen.solids import encloses
 from cadgen.export.meshes import assembly_bytes, stl_bytes
 from cadgen.solids.outline import signed_area
 from cadgen.solids.parts import gear_solid
 from cadgen.solids.planting import planting_assembly
 from cadgen.solids.pricking import pricking_assembly
-from cadgen.solids.stage import solids_outcome as _solids_outcome, solids_report
+from cadgen.solids.outcome import solids_outcome as _solids_outcome, solids_report
 from kinematics.errors import DesignError
 
 from helpers import REFERENCE, reference_text

@@ -18,22 +18,20 @@ from cadgen.solids import (
     ExportFormatError,
     SolidError,
     SolidInputError,
-    assembly_bytes,
     circle,
     closed_shell,
     encloses,
     extrude,
     from_trimesh,
     hull_of_circles,
-    load_volume,
     mass_properties,
     offset_outline,
     segments_for,
-    stl_bytes,
     to_trimesh,
     validate_holes,
     validate_outline,
 )
+from cadgen.export.meshes import assembly_bytes, load_volume, stl_bytes
 from kinematics.errors import DesignError
 
 #: Extrusions are exact up to rounding: manifold3d's 2-D engine keeps coordinates

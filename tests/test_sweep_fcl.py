@@ -11,8 +11,9 @@ m3d = pytest.importorskip("manifold3d")
 
 from cadgen.solids.errors import SolidInputError  # noqa: E402
 from cadgen.solids.parts import Assembly, Part, planar_transform  # noqa: E402
-from cadgen.sweep.fcl import (  # noqa: E402
-    FclScene, certified_distance, instance_pose, part_reach, plain_scan)
+from cadgen.sweep.fcl import FclScene  # noqa: E402
+from cadgen.sweep.scene import instance_pose, part_reach  # noqa: E402
+from cadgen.sweep.search import certified_distance, plain_scan  # noqa: E402
 
 REFERENCE = Path(__file__).resolve().parents[1] / "params" / "xin2024-planter.toml"
 Z = (0.0, 0.0, 1.0)

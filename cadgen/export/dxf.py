@@ -44,6 +44,8 @@ from pathlib import Path
 import numpy as np
 
 from cadgen.export.atomic import write_bytes_atomic
+from cadgen.geometry.contour import (closed_points, ring_measures, ring_problems, thin_outline,
+                                     thin_ring)
 from kinematics.errors import MechanismError
 
 __all__ = [
@@ -54,8 +56,7 @@ __all__ = [
     "write_gear_dxf",
     "write_train_sheet",
     "write_cam_dxf",
-    "thinned_outline",
-    "thinned_contour",
+    "write_train_files",
 ]
 
 #: Layer name -> AutoCAD colour index (7 = white/black, 1 red, 3 green, 4 cyan, 2 yellow).
@@ -81,7 +82,6 @@ CAM_CENTRE_MARK_HALF_LENGTH = 5.0
 LABEL_HEIGHT = 3.5
 LABEL_GAP_MODULES = 2.0
 #: How many times the chord tolerance is halved before the dense outline is written as is.
-MAX_TOLERANCE_HALVINGS = 30
 
 _WRITE_LOCK = threading.Lock()
 
@@ -137,37 +137,6 @@ class DxfSummary:
 # --------------------------------------------------------------------------- validation
 
 
-def _closed_points(points) -> np.ndarray:
-    """``points`` as an (n, 2) float array, a repeated closing point dropped."""
-    points = np.asarray(points, dtype=float)
-    if points.ndim == 2 and points.shape[1] == 2 and len(points) > 1 and np.array_equal(points[0], points[-1]):
-        points = points[:-1]
-    return points
-
-
-def _ring_problems(label: str, points: np.ndarray) -> list[str]:
-    """Problems of a closed curve: shape, finiteness, at least 3 points, simple, non-zero area."""
-    import shapely
-
-    if points.ndim != 2 or points.shape[1] != 2:
-        return [f"{label} must be an (n, 2) array of points, got shape {points.shape}"]
-    bad = ~np.isfinite(points).all(axis=1)
-    if bad.any():
-        first = int(np.flatnonzero(bad)[0])
-        return [f"{label} has {int(bad.sum())} non-finite point(s), the first at index {first}: "
-                f"{points[first].tolist()}"]
-    distinct = len(np.unique(points, axis=0))
-    if distinct < 3:
-        return [f"{label} needs at least 3 distinct points, got {distinct}"]
-    ring = shapely.LinearRing(points)
-    if not ring.is_simple:
-        reason = shapely.is_valid_reason(shapely.Polygon(ring))
-        return [f"{label} is self-intersecting ({reason})"]
-    if shapely.Polygon(ring).area <= 0.0:
-        return [f"{label} encloses no area"]
-    return []
-
-
 def _gear_problems(profile, *, label: str | None = None) -> list[str]:
     """Every problem of one gear profile, each naming the bad value."""
     label = label or f"gear {getattr(profile, 'name', '?')!r}"
@@ -184,10 +153,10 @@ def _plate_problems(outline, pitch_curve, centre, bore, label: str) -> list[str]
     import shapely
 
     problems = []
-    outline = _closed_points(outline)
-    outline_problems = _ring_problems(f"{label}: outline", outline)
+    outline = closed_points(outline)
+    outline_problems = ring_problems(f"{label}: outline", outline)
     problems += outline_problems
-    problems += _ring_problems(f"{label}: pitch_curve", _closed_points(pitch_curve))
+    problems += ring_problems(f"{label}: pitch_curve", closed_points(pitch_curve))
     given_centre = centre
     centre = np.asarray(centre, dtype=float)
     if centre.shape != (2,) or not np.isfinite(centre).all():
@@ -214,75 +183,6 @@ def _check_tolerance(chord_tolerance) -> float:
         raise DxfInputError("bad chord tolerance",
                             [f"chord_tolerance must be a finite number > 0 mm, got {chord_tolerance!r}"])
     return tolerance
-
-
-# --------------------------------------------------------------------------- thinning
-
-
-def _douglas_peucker(ring, tolerance: float):
-    """Douglas-Peucker thinning of a shapely ring (a seam, so tests can swap the algorithm)."""
-    return ring.simplify(tolerance, preserve_topology=True)
-
-
-def _thin_ring(points: np.ndarray, tolerance: float, *, keep_clear=None) -> tuple[np.ndarray, float]:
-    """Thin a simple closed curve to within ``tolerance``, keeping it simple.
-
-    Parameters
-    ----------
-    points : (n, 2) float
-        Simple closed curve, the first point not repeated.
-    tolerance : float
-        mm, > 0.
-    keep_clear : (centre (2,), radius) or None
-        A disc the thinned ring must still enclose with clearance (the bore).
-
-    Returns
-    -------
-    points : (k, 2) float
-        Thinned curve, counter-clockwise, the first point not repeated.
-    tolerance_used : float
-        The tolerance that gave a simple ring (``0.0``: the input returned unthinned).
-    """
-    import shapely
-
-    ring = shapely.LinearRing(points)
-
-    def acceptable(candidate) -> bool:
-        if candidate.is_empty or candidate.geom_type != "LinearRing" or len(candidate.coords) < 4:
-            return False
-        if not candidate.is_simple:
-            return False
-        polygon = shapely.Polygon(candidate)
-        if polygon.area <= 0.0:
-            return False
-        if keep_clear is not None:
-            centre, radius = keep_clear
-            point = shapely.Point(centre)
-            if not polygon.contains(point) or candidate.distance(point) <= radius:
-                return False
-        return True
-
-    tolerance_used = 0.0
-    result = points
-    trial = tolerance
-    for _ in range(MAX_TOLERANCE_HALVINGS + 1):
-        candidate = _douglas_peucker(ring, trial)
-        if acceptable(candidate):
-            result = np.asarray(candidate.coords, dtype=float)[:-1]
-            tolerance_used = trial
-            break
-        trial /= 2.0
-    if not shapely.LinearRing(result).is_ccw:
-        result = result[::-1]
-    return np.ascontiguousarray(result), tolerance_used
-
-
-def _ring_measures(points: np.ndarray) -> tuple[float, float]:
-    """Area and perimeter of a closed polygon, (n, 2) points not repeated."""
-    x, y = points[:, 0], points[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
-    perimeter = float(np.linalg.norm(np.roll(points, -1, axis=0) - points, axis=1).sum())
-    return area, perimeter
 
 
 # --------------------------------------------------------------------------- document
@@ -348,38 +248,14 @@ def _audited_bytes(doc, path: Path) -> bytes:
     return doc.encode(stream.getvalue())
 
 
-def _thin_outline(points: np.ndarray, tolerance: float, centre, bore_radius: float):
-    """A cutting outline thinned to ``tolerance``, still clear of its bore: (ring, tolerance used)."""
-    keep_clear = ((np.asarray(centre, dtype=float), float(bore_radius)) if bore_radius > 0
-                  else None)
-    return _thin_ring(points, tolerance, keep_clear=keep_clear)
-
-
 def _thin_gear(profile, outline: np.ndarray, pitch: np.ndarray, tolerance: float):
     """Thinned outline, its tolerance, and thinned pitch curve of a validated profile (body frame)."""
-    thin_outline, used = _thin_outline(outline, tolerance, profile.centre, profile.bore_radius)
-    thin_pitch, _ = _thin_ring(pitch, tolerance)
-    return thin_outline, used, thin_pitch
+    thinned, used = thin_outline(outline, tolerance, profile.centre, profile.bore_radius)
+    thin_pitch, _ = thin_ring(pitch, tolerance)
+    return thinned, used, thin_pitch
 
 
 # --------------------------------------------------------------------------- public API
-
-
-def thinned_outline(profile, chord_tolerance: float = 0.005) -> np.ndarray:
-    """The outline a gear's DXF file holds: thinned to ``chord_tolerance``, simple, bore kept clear.
-
-    The solids are extruded from it, so the STL and the DXF describe the same cut part.
-    """
-    return thinned_contour(profile.outline, chord_tolerance, centre=profile.centre,
-                           bore_radius=profile.bore_radius)
-
-
-def thinned_contour(points, chord_tolerance: float = 0.005, *, centre=(0.0, 0.0),
-                    bore_radius: float = 0.0) -> np.ndarray:
-    """A dense closed contour thinned as the DXF writers thin it (a cam's, a gear's)."""
-    return _thin_outline(_closed_points(points), _check_tolerance(chord_tolerance), centre,
-                         bore_radius)[0]
-
 
 
 def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float = 0.005) -> DxfSummary:
@@ -389,7 +265,7 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     ----------
     path : str or path-like
         Target file; its directory must exist. An existing file is replaced atomically.
-    profile : cadgen.gears.profile.GearProfile
+    profile : cadgen.gears.teeth.GearProfile
         The gear, in its body frame: ``outline`` (n, 2) and ``pitch_curve`` (m, 2)
         closed, simple, finite; ``module`` > 0; ``bore_radius`` >= 0, the bore
         inside the outline.
@@ -420,13 +296,13 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     if problems:
         raise DxfInputError(f"cannot export gear {getattr(profile, 'name', '?')!r} to DXF", problems)
     path = Path(path)
-    outline, used, pitch = _thin_gear(profile, _closed_points(profile.outline),
-                                      _closed_points(profile.pitch_curve), tolerance)
+    outline, used, pitch = _thin_gear(profile, closed_points(profile.outline),
+                                      closed_points(profile.pitch_curve), tolerance)
     doc = _new_document()
     _add_gear(doc.modelspace(), outline, pitch, np.asarray(profile.centre, dtype=float),
               float(profile.bore_radius), float(profile.module))
     write_bytes_atomic(path, _audited_bytes(doc, path))
-    area, perimeter = _ring_measures(outline)
+    area, perimeter = ring_measures(outline)
     return DxfSummary(path, len(outline), used, area, perimeter)
 
 
@@ -509,8 +385,8 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
     for profile, angle, offset in placements:
         key = id(profile)
         if key not in thinned:
-            thinned[key] = _thin_gear(profile, _closed_points(profile.outline),
-                                      _closed_points(profile.pitch_curve), tolerance)
+            thinned[key] = _thin_gear(profile, closed_points(profile.outline),
+                                      closed_points(profile.pitch_curve), tolerance)
         outline, used, pitch = thinned[key]
         rotation = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
         centre = np.asarray(profile.centre, dtype=float)
@@ -523,7 +399,7 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
         label_y = float(placed_outline[:, 1].min()) - LABEL_GAP_MODULES * module
         msp.add_text(profile.name, height=float(label_height), dxfattribs={"layer": "LABELS"}).set_placement(
             (float(placed_centre[0]), label_y), align=TextEntityAlignment.TOP_CENTER)
-        area, perimeter = _ring_measures(outline)
+        area, perimeter = ring_measures(outline)
         summaries.append(DxfSummary(path, len(outline), used, area, perimeter))
     write_bytes_atomic(path, _audited_bytes(doc, path))
     return tuple(summaries)
@@ -544,11 +420,25 @@ def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius:
     if problems:
         raise DxfInputError(f"cannot export {label} to DXF", problems)
     path = Path(path)
-    outline, used = _thin_outline(_closed_points(contour), tolerance, centre, bore_radius)
-    pitch, _ = _thin_ring(_closed_points(pitch_curve), tolerance)
+    outline, used = thin_outline(closed_points(contour), tolerance, centre, bore_radius)
+    pitch, _ = thin_ring(closed_points(pitch_curve), tolerance)
     doc = _new_document()
     _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
               CAM_CENTRE_MARK_HALF_LENGTH / CENTRE_MARK_HALF_LENGTH_MODULES)
     write_bytes_atomic(path, _audited_bytes(doc, path))
-    area, perimeter = _ring_measures(outline)
+    area, perimeter = ring_measures(outline)
     return DxfSummary(path, len(outline), used, area, perimeter)
+
+
+def write_train_files(train, folder, chord_tolerance: float) -> list:
+    """One DXF per gear and an assembled sheet of the train at the start position."""
+    from cadgen.gears.trains import _placements
+
+    written = []
+    for profile, _, _, _ in train.gears:
+        summary = write_gear_dxf(folder / f"{profile.file_stem}.dxf", profile,
+                                 chord_tolerance=chord_tolerance)
+        written.append(summary.path)
+    write_train_sheet(folder / "train.dxf", _placements(train), chord_tolerance=chord_tolerance)
+    written.append(folder / "train.dxf")
+    return written

@@ -44,6 +44,7 @@ __all__ = [
     "load_volume",
     "write_stl",
     "write_assembly",
+    "write_solids",
 ]
 
 #: Fixed zip timestamp (the earliest a zip can hold; the one trimesh uses).
@@ -234,3 +235,24 @@ def write_assembly(path, parts, file_type: str | AssemblyFormat | None = None) -
     """
     path = Path(path)
     return write_bytes_atomic(path, assembly_bytes(parts, file_type or path.suffix.lstrip(".")))
+
+
+def write_solids(outcome, staging) -> list:
+    """Write ``solids/<part>.stl`` and ``solids/assembly.<glb|3mf>``; return the relative paths.
+
+    ``outcome`` is a :class:`cadgen.solids.outcome.SolidsOutcome`. One binary STL per
+    distinct part in its own frame (a part both planting arms use is written once), and
+    the assembly with every instance placed at the outcome's carrier angle.
+    """
+    folder = staging / "solids"
+    folder.mkdir()
+    written = []
+    for part in outcome.assembly.parts:
+        (folder / f"{part.name}.stl").write_bytes(stl_bytes(part.mesh))
+        written.append(f"solids/{part.name}.stl")
+    placed = [(name, part.mesh, pose) for name, part, pose
+              in outcome.assembly.placements(outcome.carrier_angle)]
+    (folder / f"assembly.{outcome.file_type}").write_bytes(
+        assembly_bytes(placed, outcome.file_type))
+    written.append(f"solids/assembly.{outcome.file_type}")
+    return written

@@ -22,7 +22,7 @@ import shapely.errors
 from kinematics.arclength import ArcLengthCurve
 from kinematics.errors import DesignError
 
-from cadgen.gears.profile import GearProfile
+from cadgen.gears.teeth import GearProfile
 from cadgen.gears.teeth import CutterChoice, ToothSystem, gear_outline
 
 __all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "generate_gear",

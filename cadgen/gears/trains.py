@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,12 +18,48 @@ import numpy as np
 from kinematics.errors import DesignError
 
 from cadgen.gears.pairs import PitchPair, circle_pair, generate_pair
-from cadgen.solids.housings import circular_module, planting_circular_radii
 from cadgen.gears.meshing import meshing_check, relieve_interference
 from cadgen.gears.teeth import ToothSystem
 
-__all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "pricking_train", "circular_module",
-           "write_train_files", "train_report", "pair_figures", "pair_figure_jobs"]
+__all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "pricking_train",
+           "circular_module", "planting_circular_radii", "MIN_CIRCULAR_TEETH", "train_report"]
+
+#: Circular gears get at least this many teeth: a standard rack undercuts fewer (2/sin^2(20 deg)).
+MIN_CIRCULAR_TEETH = 17
+
+
+def circular_module(radii, requested=None) -> float:
+    """The requested module, or the largest 0.05-mm step (5 mm down) giving whole tooth counts.
+
+    Only modules that give every circular gear at least ``MIN_CIRCULAR_TEETH``
+    teeth are considered, so no circular gear is undercut.
+    """
+    if requested is not None:
+        counts = [2 * r / requested for r in radii]
+        if not all(abs(c - round(c)) < 1e-6 for c in counts):
+            raise DesignError.single(
+                "gears.circular_module", "fractional_teeth",
+                f"module {requested:g} mm gives tooth counts {', '.join(f'{c:.3f}' for c in counts)}"
+                f" for the circular gears of radii {', '.join(f'{r:g}' for r in radii)} mm: "
+                "choose a module that divides every pitch diameter")
+        return float(requested)
+    for step in range(100, 9, -1):
+        module = step * 0.05
+        counts = [2 * r / module for r in radii]
+        if all(abs(c - round(c)) < 1e-6 and round(c) >= MIN_CIRCULAR_TEETH for c in counts):
+            return round(module, 10)
+    raise DesignError.single("gears.circular_module", "fractional_teeth",
+                             f"no module from 0.5 to 5 mm gives whole tooth counts for the circular "
+                             f"gears of radii {', '.join(f'{r:g}' for r in radii)} mm; set one")
+
+
+
+def planting_circular_radii(mechanism) -> list:
+    """Pitch radii of the planting mechanism's circular gears: train 1's set (sun, idlers,
+    planet) and gearbox 2's 1:1 gear ``r``."""
+    R = mechanism.R
+    return [R, R * mechanism.i12, R * mechanism.i13, R, mechanism.r]
+
 
 
 @dataclass(frozen=True)
@@ -198,20 +233,6 @@ def _placements(train: GearTrain):
     return out
 
 
-def write_train_files(train: GearTrain, folder, chord_tolerance: float) -> list:
-    """One DXF per gear and an assembled sheet of the train at the start position."""
-    from cadgen.export.dxf import write_gear_dxf, write_train_sheet
-
-    written = []
-    for profile, _, _, _ in train.gears:
-        summary = write_gear_dxf(folder / f"{profile.file_stem}.dxf", profile,
-                                 chord_tolerance=chord_tolerance)
-        written.append(summary.path)
-    write_train_sheet(folder / "train.dxf", _placements(train), chord_tolerance=chord_tolerance)
-    written.append(folder / "train.dxf")
-    return written
-
-
 def train_report(train: GearTrain) -> dict:
     gears = []
     for profile, check, stage, _ in train.gears:
@@ -242,38 +263,3 @@ def train_report(train: GearTrain) -> dict:
     failures = [{"stage": stage, "path": p.path, "code": p.code, "message": p.message}
                 for stage, p in train.failures]
     return {"gears": gears, "meshes": meshes, "failures": failures}
-
-
-def pair_figure_jobs(train: GearTrain) -> dict:
-    """``{file name: callable -> PNG bytes}``: a picture of each pair at the start position."""
-    jobs = {}
-    for index, stage in enumerate(train.stages):
-        slug = re.sub(r"[^a-z0-9]+", "-", stage.name.lower()).strip("-")
-        jobs[f"gears-{index + 1}-{slug}.png"] = lambda stage=stage: _pair_figure(stage)
-    return jobs
-
-
-def pair_figures(train: GearTrain) -> dict:
-    """A picture of each pair at the start position (PNG bytes, keyed by file name)."""
-    return {name: draw() for name, draw in pair_figure_jobs(train).items()}
-
-
-def _pair_figure(stage) -> bytes:
-    from cadgen.report.plots.planting import _figure, _fill, _png
-
-    figure, ax = _figure(8.0, 5.0)
-    pair = stage.generated.pair
-    rotations = pair.rotations(np.array([0.0]))
-    for k, (profile, check) in enumerate(zip(stage.generated.profiles, stage.generated.checks)):
-        outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
-        _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
-              f"({profile.teeth} teeth, {check.cutter})")
-        ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
-    m = stage.meshing
-    ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
-                 f"{m.interference_poses} interfering poses of {m.poses}, "
-                 f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
-    ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="upper right")
-    ax.grid(alpha=0.2)
-    return _png(figure)

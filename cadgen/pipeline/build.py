@@ -45,7 +45,8 @@ import numpy as np
 from kinematics.errors import ConvergenceError, DesignError, MechanismError
 
 __all__ = ["EFFECT_STAGES", "plan", "stage_warnings", "BuildResult", "build", "EXIT_OK",
-           "EXIT_CHECKS_FAILED"]
+           "EXIT_CHECKS_FAILED", "run_analysis", "AnalysisResult"]
+
 
 EXIT_OK = 0
 EXIT_CHECKS_FAILED = 1
@@ -296,7 +297,7 @@ def _gearless_parts(run):
 
 
 def _parts(run, gears: bool = True):
-    from cadgen.solids.stage import solids_outcome
+    from cadgen.solids.outcome import solids_outcome
 
     params = run.params
     train = run.values.get("teeth") if gears and run.status("teeth") == "ok" else None
@@ -376,7 +377,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         Overrides ``resolution.steps_per_revolution`` (planting).
     preset : {"draft", "standard", "fine"}, optional
         Overrides the file's ``scene.preset``: the resolution of every knob the file
-        leaves out (see :mod:`cadgen.params.presets`).
+        leaves out (see :mod:`cadgen.params.scene`).
 
     Raises
     ------
@@ -387,7 +388,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         Before any stage runs, when a problem validation found belongs to a stage
         the scene runs (see :func:`stage_warnings`); of other stages, warnings.
     """
-    from cadgen.params.presets import apply_preset
+    from cadgen.params.scene import apply_preset
 
     if output_root is not None:
         from cadgen.export.atomic import check_output_root
@@ -451,3 +452,35 @@ def _jsonable(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+# ----------------------------------------------------------------------------------------------
+# The earlier entry point
+
+AnalysisResult = BuildResult
+
+
+def run_analysis(params, output_root: Path | str | None = Path("outputs"),
+                 steps_per_revolution: int | None = None, plots: bool = True,
+                 gears: bool = True, cam: bool = True, solids: bool = True,
+                 sweeps: bool = False) -> BuildResult:
+    """Analyse one validated design; write ``<output_root>/<name>/`` atomically.
+
+    ``gears`` cuts, checks and meshes every gear and writes their DXF files;
+    ``cam`` designs the duckbill cam (planting) and writes cam.dxf; ``solids``
+    builds every part and writes the STL files and the assembly; ``sweeps`` runs
+    the FCL arm-interference and ground-clearance sweeps; ``plots`` draws the
+    pictures and the HTML report. With ``output_root=None`` nothing is written.
+    """
+    effects = ["metrics", "curves"]
+    if gears:
+        effects += ["teeth", "meshing", "dxf"]
+    if cam and params.mechanism == "planting":
+        effects += ["cam", "dxf"]
+    if solids:
+        effects += ["solids", "stl"]
+    if sweeps:
+        effects += ["arm_interference", "ground_clearance"]
+    if plots:
+        effects += ["plots", "report"]
+    return build(params, output_root, effects=list(dict.fromkeys(effects)),
+                 steps=steps_per_revolution)

@@ -1,6 +1,6 @@
 """The clearances of the solids through a revolution (FCL): arm against arm, housings against ground.
 
-Each is a certified least distance (:func:`cadgen.sweep.fcl.certified_distance`)
+Each is a certified least distance (:func:`cadgen.sweep.search.certified_distance`)
 from the speed and acceleration bounds of the moving bodies, per radian of carrier
 angle (see that module for the formula ``v + w * reach + u``):
 
@@ -60,7 +60,7 @@ def _blade_rates(cam, mechanism, samples: int = 20_000):
 
 def _arm_bounds(mechanism, parts, cam):
     """(speed, acceleration) bounds of any point of one arm's parts that are present."""
-    from cadgen.sweep.fcl import part_reach
+    from cadgen.sweep.scene import part_reach
 
     rc = mechanism.carrier_radii["C"]
     spin, turn = _planter_turn(mechanism)
@@ -137,7 +137,8 @@ def _kinematic(evaluation, key):
 
 def arm_interference(params, mechanism, solids, cam) -> dict:
     """Certified least distance between the two planting arms' solids over a revolution."""
-    from cadgen.sweep.fcl import FclScene, certified_distance
+    from cadgen.sweep.fcl import FclScene
+    from cadgen.sweep.search import certified_distance
 
     assembly = solids.assembly
     parts = {part.name: part for part in assembly.parts}
@@ -161,7 +162,9 @@ def _arm_distance_estimate(params, mechanism):
 
 def ground_clearance(params, design, solids, field) -> dict:
     """Certified least gap between every housing and the ground mesh over a revolution."""
-    from cadgen.sweep.fcl import FclScene, certified_distance, part_reach
+    from cadgen.sweep.fcl import FclScene
+    from cadgen.sweep.scene import part_reach
+    from cadgen.sweep.search import certified_distance
 
     assembly = solids.assembly
     parts = {part.name: part for part in assembly.parts}

@@ -35,7 +35,7 @@ def figure_jobs(run) -> dict:
 
         jobs.update(planting_figure_jobs(values["kinematics"], values["metrics"]))
     if "teeth" in ok and values["teeth"].stages:
-        from cadgen.gears.trains import pair_figure_jobs
+        from cadgen.report.plots.parts import pair_figure_jobs
 
         jobs.update(pair_figure_jobs(values["teeth"]))
     if "cam" in ok:
@@ -46,7 +46,7 @@ def figure_jobs(run) -> dict:
         jobs["assembly.png"] = lambda: _assembly(run)
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:
-        from cadgen.report.plots.sweep import clearance_figure
+        from cadgen.report.plots.parts import clearance_figure
 
         jobs["clearance.png"] = lambda: clearance_figure(sweeps)
     return jobs
@@ -99,7 +99,7 @@ def _draw_worker_jobs() -> dict:
 
 
 def _assembly(run) -> bytes:
-    from cadgen.report.plots.solids import assembly_view
+    from cadgen.report.plots.parts import assembly_view
 
     outcome, params, values = run.values["parts"], run.params, run.values
     angle = outcome.carrier_angle

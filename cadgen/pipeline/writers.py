@@ -27,14 +27,14 @@ def writers_for(run) -> list:
         if "cam" in ok and run.values["cam"].cuttable:
             writers.append(lambda staging: _write_cam(run, staging))
     if "stl" in effects and "parts" in ok:
-        from cadgen.solids.stage import write_solids
+        from cadgen.export.meshes import write_solids
 
         writers.append(lambda staging: write_solids(run.values["parts"], staging))
     return writers
 
 
 def _write_gears(run, staging):
-    from cadgen.gears.trains import write_train_files
+    from cadgen.export.dxf import write_train_files
 
     (staging / "gears").mkdir()
     return [f"gears/{Path(path).name}" for path in

@@ -133,7 +133,7 @@ def assemble_report(run, set_aside: dict) -> dict:
 
         report["cam"] = cam_section(values["cam"])
     if "parts" in ok:
-        from cadgen.solids.stage import solids_report
+        from cadgen.solids.outcome import solids_report
 
         report["solids"] = solids_report(values["parts"])
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}

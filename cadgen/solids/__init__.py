@@ -1,4 +1,4 @@
-"""A generic solids toolkit: validated outlines, extrusions, closed housings, mass, export.
+"""A generic solids toolkit: validated outlines, extrusions, closed housings, mass properties.
 
 Modules
 -------
@@ -15,9 +15,10 @@ shell
     :func:`encloses`, the check that a part lies inside its cavity.
 mass
     :func:`mass_properties`: volume, area, mass, centre of mass, inertia (mm, kg).
-export
-    Deterministic bytes: :func:`stl_bytes`, :func:`assembly_bytes` (GLB, 3MF),
-    :func:`load_volume` for round trips, atomic :func:`write_stl` / :func:`write_assembly`.
+housings, ground, parts, planting, pricking, outcome
+    The mechanisms' parts built with the toolkit, and what a build's solids came to.
+
+Writing the meshes (STL, GLB, 3MF) is :mod:`cadgen.export.meshes`'s job.
 errors
     :class:`SolidError` and friends (the project's :class:`~kinematics.errors.MechanismError` family).
 tolerances
@@ -27,14 +28,6 @@ Nothing heavy is imported here: manifold3d, trimesh and shapely load on first us
 """
 
 from cadgen.solids.errors import ExportFormatError, SolidError, SolidInputError
-from cadgen.export.meshes import (
-    AssemblyFormat,
-    assembly_bytes,
-    load_volume,
-    stl_bytes,
-    write_assembly,
-    write_stl,
-)
 from cadgen.solids.extrude import cross_section, extrude, from_trimesh, to_trimesh
 from cadgen.solids.mass import mass_properties
 from cadgen.solids.outline import (
@@ -51,12 +44,10 @@ from cadgen.solids.outline import (
 from cadgen.solids.shell import Housing, closed_shell, encloses, shell_outlines
 
 __all__ = [
-    "AssemblyFormat",
     "ExportFormatError",
     "Housing",
     "SolidError",
     "SolidInputError",
-    "assembly_bytes",
     "circle",
     "closed_shell",
     "cross_section",
@@ -65,17 +56,13 @@ __all__ = [
     "from_trimesh",
     "holes_problems",
     "hull_of_circles",
-    "load_volume",
     "mass_properties",
     "offset_outline",
     "outline_problems",
     "segments_for",
     "shell_outlines",
     "signed_area",
-    "stl_bytes",
     "to_trimesh",
     "validate_holes",
     "validate_outline",
-    "write_assembly",
-    "write_stl",
 ]

@@ -14,47 +14,11 @@ from dataclasses import dataclass
 
 from kinematics.clearance import HousingCircle
 from kinematics.errors import DesignError
-from kinematics.evaluation import default_housing_circles
+from kinematics.planting import PlantingMechanism
 
-__all__ = ["MIN_CIRCULAR_TEETH", "circular_module", "planting_circular_radii", "ShellSize",
-           "planting_shells", "housing_circles"]
+from cadgen.gears.trains import circular_module, planting_circular_radii
 
-#: Circular gears get at least this many teeth: a standard rack undercuts fewer (2/sin^2(20 deg)).
-MIN_CIRCULAR_TEETH = 17
-
-
-def circular_module(radii, requested=None) -> float:
-    """The requested module, or the largest 0.05-mm step (5 mm down) giving whole tooth counts.
-
-    Only modules that give every circular gear at least ``MIN_CIRCULAR_TEETH``
-    teeth are considered, so no circular gear is undercut.
-    """
-    if requested is not None:
-        counts = [2 * r / requested for r in radii]
-        if not all(abs(c - round(c)) < 1e-6 for c in counts):
-            raise DesignError.single(
-                "gears.circular_module", "fractional_teeth",
-                f"module {requested:g} mm gives tooth counts {', '.join(f'{c:.3f}' for c in counts)}"
-                f" for the circular gears of radii {', '.join(f'{r:g}' for r in radii)} mm: "
-                "choose a module that divides every pitch diameter")
-        return float(requested)
-    for step in range(100, 9, -1):
-        module = step * 0.05
-        counts = [2 * r / module for r in radii]
-        if all(abs(c - round(c)) < 1e-6 and round(c) >= MIN_CIRCULAR_TEETH for c in counts):
-            return round(module, 10)
-    raise DesignError.single("gears.circular_module", "fractional_teeth",
-                             f"no module from 0.5 to 5 mm gives whole tooth counts for the circular "
-                             f"gears of radii {', '.join(f'{r:g}' for r in radii)} mm; set one")
-
-
-
-def planting_circular_radii(mechanism) -> list:
-    """Pitch radii of the planting mechanism's circular gears: train 1's set (sun, idlers,
-    planet) and gearbox 2's 1:1 gear ``r``."""
-    R = mechanism.R
-    return [R, R * mechanism.i12, R * mechanism.i13, R, mechanism.r]
-
+__all__ = ["ShellSize", "planting_shells", "housing_circles", "envelope_circles"]
 
 @dataclass(frozen=True)
 class ShellSize:
@@ -95,9 +59,38 @@ def planting_shells(params, mechanism) -> dict:
 def housing_circles(params, mechanism) -> list:
     """Envelope circles: derived from the gear sizes, with any explicit radius in the file winning."""
     shells = planting_shells(params, mechanism)
-    circles = default_housing_circles(
+    circles = envelope_circles(
         mechanism, mechanism.module(params.pitch_curve.teeth), shells["gearbox2"].allowance,
         circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].allowance)
     explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
     return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
             for c in circles]
+
+
+def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: float, *,
+                            circular_module: float | None = None,
+                            gearbox1_allowance: float | None = None):
+    """Envelope circles of both gearboxes: the largest gear tip about each axis plus ``allowance``.
+
+    Gearbox 2 holds the non-circular pair and the 1:1 pair: at C the central
+    gear's largest tip radius, at D the larger of the intermediate gear's
+    (``a - min r1`` plus one module) and the circular gear's, at E the planet
+    gear. Gearbox 1 (carrier 1) uses the first train's gear set with converted
+    ratio -1 (sun R, idlers R i12 and R i13, planet R) with the circular
+    module's addendum; the other set is not modelled, so pass explicit radii
+    when it is larger. ``allowance`` (mm) is the housing's clearance plus wall;
+    ``gearbox1_allowance`` defaults to it, ``circular_module`` to ``module``.
+    """
+    closure = mechanism.closure
+    a = closure.centre_distance
+    r_min, r_max = closure.radius_min[1], closure.radius_max[1]
+    R, r = mechanism.R, mechanism.r
+    m_c = module if circular_module is None else circular_module
+    outer1 = allowance if gearbox1_allowance is None else gearbox1_allowance
+    box2 = {"C": r_max + module + allowance,
+            "D": max(a - r_min + module, r + m_c) + allowance,
+            "E": r + m_c + allowance}
+    box1 = {"O": R + m_c + outer1, "A": R * mechanism.i12 + m_c + outer1,
+            "B": R * mechanism.i13 + m_c + outer1, "C": R + m_c + outer1}
+    return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
+            + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])

@@ -2,7 +2,7 @@
 
 An outline is an ``(n, 2)`` float array of points in mm, counter-clockwise, the
 first point not repeated at the end (the convention of
-:class:`cadgen.gears.profile.GearProfile`).
+:class:`cadgen.gears.teeth.GearProfile`).
 
 Why validate at all: manifold3d turns an outline into a cross section with a
 boolean union under a fill rule, and a self-intersecting outline (a bowtie) comes

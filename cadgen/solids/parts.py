@@ -100,7 +100,7 @@ def gear_solid(profile, face_width: float, segments: int, path: str, chord_toler
     The outline is the one the gear's DXF holds (thinned to ``chord_tolerance``), so
     the STL and the cutting file describe the same part.
     """
-    from cadgen.export.dxf import thinned_outline
+    from cadgen.geometry.contour import thinned_outline
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import circle
 

@@ -202,7 +202,7 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments):
 
 
 def _cam_part(params, mechanism, cam_design, layout, segments):
-    from cadgen.export.dxf import thinned_contour
+    from cadgen.geometry.contour import thinned_contour
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import circle
 

@@ -1,34 +1,17 @@
-"""Collision sweep of an assembly through a revolution: certified least distance, interference.
+"""The python-fcl adapter of the sweep: part meshes as FCL models, posed and queried per carrier angle.
 
-The FCL adapter of the clearance checks. :class:`FclScene` builds one
-``fcl.BVHModel`` per part mesh (float64 vertices, ``endModel`` called) and one
-``fcl.CollisionObject`` per part instance, once; each query only moves the
-objects to the poses of carrier angle ``phi``. :func:`certified_distance` feeds
-the scene's distance to :func:`kinematics.sweep.certified_minimum` and scans the
-same samples for interference; :func:`plain_scan` is the sampling-only peer.
+:class:`FclScene` builds one ``fcl.BVHModel`` per part mesh (float64 vertices,
+``endModel`` called) and one ``fcl.CollisionObject`` per part instance, once;
+each query only moves the objects to the poses of carrier angle ``phi``. It is
+the engine behind the certified search of :mod:`cadgen.sweep.search`, and the
+only module of the package that imports ``fcl`` (inside its functions, so that
+importing it stays cheap).
 
 The distance is the Euclidean distance between the two groups of *solids*: 0
 when a surface of one crosses or touches a surface of the other, and also when
 one solid lies wholly inside the other (FCL sees only triangles: it reports the
 gap between the surfaces and ``collide`` says no, so the scene tests one vertex
-of each closed surface by its winding number in the other mesh). That distance
-is continuous in ``phi`` with ``|d distance / d phi|`` at most the largest
-relative speed of any point of one group against any point of the other.
-
-Lipschitz bound (the caller's, mm per rad of carrier angle). For one body
-whose origin moves at most ``v`` mm/rad, which turns at most ``w`` rad/rad, and
-whose part moves in the body (a gear on its shaft, a blade on its hinge) at
-most ``u`` mm/rad, every point of the part moves at most::
-
-    v + w * part_reach(part, origin) + u
-
-A group's bound is the largest over its instances, and the pair's is the sum
-of the two groups' bounds (a fixed group contributes 0). :func:`part_reach`
-gives the geometric factor; the speeds belong to the mechanism. The optional
-acceleration bound is formed the same way from the origin's acceleration
-``a``, the angular acceleration ``alpha`` and rate ``w``: ``a + (alpha + w**2)
-* reach (+ the local motion's)``; with it the search is second order (see
-:func:`certified_distance`).
+of each closed surface by its winding number in the other mesh).
 
 python-fcl 0.7.0.11, measured (see ``tests/test_sweep_fcl.py``):
 
@@ -45,100 +28,21 @@ python-fcl 0.7.0.11, measured (see ``tests/test_sweep_fcl.py``):
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
-from typing import NamedTuple
+from dataclasses import dataclass
 
 import numpy as np
 
 from cadgen.solids.errors import SolidInputError
+from cadgen.sweep.scene import Proximity, part_instances
 
-__all__ = [
-    "INTERFERENCE_XTOL",
-    "INTERFERENCE_RESOLUTION",
-    "MAX_EVALUATIONS",
-    "Proximity",
-    "FclScene",
-    "SweepResult",
-    "certified_distance",
-    "plain_scan",
-    "part_reach",
-    "instance_pose",
-]
+__all__ = ["FclScene"]
 
-#: Carrier-angle tolerance (rad) of the ends of an interference range (bisection).
-INTERFERENCE_XTOL = 1e-9
-#: Narrowest interval (rad) the interference scan splits where the Lipschitz bound
-#: cannot rule out an overlap; an overlap shorter than this can hide in one.
-INTERFERENCE_RESOLUTION = 1e-6
-#: Default budget of poses of :func:`certified_distance` (each pass).
-MAX_EVALUATIONS = 20_000
 #: Covering spheres of a part: 2**depth leaves, on triangles no longer than this
 #: fraction of the part's bounding radius (they only prune pairs: speed, not accuracy).
 _LEAF_DEPTH = 4
 _LEAF_EDGE_FRACTION = 0.25
 #: A point counts as inside a mesh when its winding number exceeds this.
 _WINDING_INSIDE = 0.5
-
-
-# ------------------------------------------------------------------ poses
-def _instances(assembly):
-    """``{instance name: (part, body, phase)}`` of every placed copy, in assembly order."""
-    out = {}
-    for part in assembly.parts:
-        for name, body, phase in part.instances or ((part.name, part.body, 0.0),):
-            out[name] = (part, body, float(phase))
-    return out
-
-
-def instance_pose(assembly, name: str, phi: float) -> np.ndarray:
-    """World transform (4, 4) of one part instance at carrier angle ``phi`` (rad).
-
-    The same pose :meth:`Assembly.placements` gives, without placing every other part.
-    """
-    instances = _instances(assembly)
-    if name not in instances:
-        raise SolidInputError("name", f"no part instance {name!r} in the assembly; "
-                                      f"instances: {sorted(instances)}")
-    part, body, phase = instances[name]
-    return assembly.body_pose(body, phi + phase) @ part.local(phi + phase)
-
-
-def part_reach(part, body_origin_local=(0.0, 0.0, 0.0), *, phi: float = 0.0, axis=None) -> float:
-    """Largest distance (mm) of a part's vertices from a point of its body, placed in the body.
-
-    Parameters
-    ----------
-    part : Part
-    body_origin_local : (3,) float
-        The point of the body frame the body's speed bound refers to (its origin,
-        or the hub it turns about), mm.
-    phi : float
-        Carrier angle of the local placement (rad). Exact for a part fixed in its
-        body; a part moving in its body needs its own motion bound on top.
-    axis : (3,) float, optional
-        Measure the distance from the line through ``body_origin_local`` along
-        ``axis`` instead (a body turning about that axis: the tighter factor).
-
-    Returns
-    -------
-    float
-    """
-    origin = np.asarray(body_origin_local, dtype=float)
-    if origin.shape != (3,) or not np.all(np.isfinite(origin)):
-        raise SolidInputError("body_origin_local",
-                              f"must be 3 finite numbers, not {body_origin_local!r}")
-    vertices = np.asarray(part.mesh.vertices, dtype=float)
-    local = np.asarray(part.local(phi), dtype=float)
-    offsets = vertices @ local[:3, :3].T + local[:3, 3] - origin
-    if axis is not None:
-        direction = np.asarray(axis, dtype=float)
-        norm = float(np.linalg.norm(direction)) if direction.shape == (3,) else 0.0
-        if not (np.isfinite(norm) and norm > 0.0):
-            raise SolidInputError("axis", f"must be a non-zero 3-vector, not {axis!r}")
-        direction = direction / norm
-        offsets = offsets - np.outer(offsets @ direction, direction)
-    return float(np.linalg.norm(offsets, axis=1).max())
 
 
 # ------------------------------------------------------------------ containment
@@ -222,24 +126,6 @@ def _shape(mesh, depth=_LEAF_DEPTH, edge_fraction=_LEAF_EDGE_FRACTION):
 
 
 # ------------------------------------------------------------------ scene
-class Proximity(NamedTuple):
-    """The closest approach of two groups at one pose.
-
-    ``distance`` (mm) is exactly 0.0 when the groups overlap (surfaces cross or
-    touch, or one solid lies inside the other); the two points (world frame, mm)
-    are then both a point of the overlap. ``pair`` names the instances.
-    """
-
-    distance: float
-    point_a: np.ndarray
-    point_b: np.ndarray
-    pair: tuple
-
-    @property
-    def overlap(self) -> bool:
-        return self.distance <= 0.0
-
-
 class FclScene:
     """Two groups of an assembly's part instances, as FCL objects that follow the carrier angle.
 
@@ -265,7 +151,7 @@ class FclScene:
         import fcl
 
         group_a, group_b = tuple(group_a), tuple(group_b)
-        instances = _instances(assembly)
+        instances = part_instances(assembly)
         unknown = [n for n in group_a + group_b if n not in instances]
         if unknown:
             raise SolidInputError("groups", f"unknown part instances {unknown}; "
@@ -392,256 +278,3 @@ class FclScene:
         """Distances ``(n,)`` at carrier angles ``phis`` ``(n,)``, for :func:`certified_minimum`."""
         phis = np.atleast_1d(np.asarray(phis, dtype=float))
         return np.array([self.distance(phi).distance for phi in phis.ravel()]).reshape(phis.shape)
-
-
-# ------------------------------------------------------------------ sweep
-@dataclass(frozen=True)
-class SweepResult:
-    """Outcome of :func:`certified_distance`.
-
-    Attributes
-    ----------
-    minimum : float
-        Least distance found (mm); 0 when the groups interfere.
-    argument : float
-        Carrier angle where it occurs (rad).
-    bound : float
-        Certified lower bound: no carrier angle of the interval gives less (mm).
-    certified : bool
-        The bound is within ``atol`` of the minimum.
-    evaluations : int
-        Poses evaluated in all (screen, refinement and interference scan).
-    point_a, point_b : (3,) float
-        Nearest points at ``argument``, world frame (mm); equal when overlapping.
-    pair : tuple of str
-        The instances they belong to.
-    interference_ranges : list of (float, float)
-        Carrier-angle ranges (rad) where the groups overlap, ends within
-        ``INTERFERENCE_XTOL``; an overlap that runs through ``upper`` and on from
-        ``lower`` is two ranges.
-    unresolved : int
-        Intervals no wider than ``resolution`` (or left when the budget ran out)
-        where the Lipschitz bound could not rule out a brief overlap and none was
-        sampled (see :func:`certified_distance`).
-    samples_phi, samples_distance : (steps + 1,) float
-        The screening grid and its distances, to plot distance against carrier angle.
-    lipschitz, acceleration, atol : float
-        As given (``acceleration`` None when not given).
-    seconds : float
-        Wall time of the sweep.
-    """
-
-    minimum: float
-    argument: float
-    bound: float
-    certified: bool
-    evaluations: int
-    point_a: np.ndarray
-    point_b: np.ndarray
-    pair: tuple
-    interference_ranges: list
-    unresolved: int
-    samples_phi: np.ndarray = field(repr=False)
-    samples_distance: np.ndarray = field(repr=False)
-    lipschitz: float = 0.0
-    acceleration: float | None = None
-    atol: float = 0.0
-    seconds: float = 0.0
-
-    @property
-    def interferes(self) -> bool:
-        return bool(self.interference_ranges) or self.minimum <= 0.0
-
-
-def _curvature(acceleration, lipschitz):
-    """``d'' <= A + L^2 / d`` on an interval whose first-order lower bound is ``d > 0``."""
-
-    def bound(first_order_bounds):
-        with np.errstate(divide="ignore"):
-            return np.where(first_order_bounds > 0.0,
-                            acceleration + lipschitz**2 / first_order_bounds, np.inf)
-
-    return bound
-
-
-class _Memo:
-    """The scene's distance with a cache, so the screening grid is posed once for both passes."""
-
-    def __init__(self, scene):
-        self.scene = scene
-        self.values = {}
-
-    def __call__(self, phis):
-        phis = np.atleast_1d(np.asarray(phis, dtype=float))
-        out = np.empty(phis.shape)
-        for index, phi in np.ndenumerate(phis):
-            key = float(phi)
-            if key not in self.values:
-                self.values[key] = self.scene.distance(key)
-            out[index] = self.values[key].distance
-        return out
-
-    def proximity(self, phi):
-        self(np.array([phi]))
-        return self.values[float(phi)]
-
-
-def _interference(distance, grid, values, lipschitz, xtol, resolution, budget):
-    """Overlap ranges from the screening samples, refined where the bound allows an overlap.
-
-    Level by level, as :func:`certified_minimum` does: an interval with both ends
-    overlapping counts as overlapping; both ends clear and
-    ``(d_left + d_right - L h) / 2 > 0``: clear, certified; one end of each:
-    split until narrower than ``xtol`` (bisection of the boundary); otherwise
-    split until narrower than ``resolution``. Returns ``(ranges, unresolved,
-    evaluations)``; intervals left when ``budget`` evaluations are spent count
-    as unresolved.
-    """
-    left, right = grid[:-1], grid[1:]
-    f_left, f_right = values[:-1], values[1:]
-    ranges, unresolved, evaluations = [], 0, 0
-    while left.size:
-        o_left, o_right = f_left <= 0.0, f_right <= 0.0
-        width = right - left
-        both = o_left & o_right
-        ranges += list(zip(left[both], right[both]))
-        mixed = o_left ^ o_right
-        settled = mixed & (width <= xtol)
-        middle = 0.5 * (left + right)
-        ranges += [(a, m) if oa else (m, b) for a, b, m, oa in
-                   zip(left[settled], right[settled], middle[settled], o_left[settled])]
-        clear = ~(o_left | o_right)
-        possible = clear & (0.5 * (f_left + f_right - lipschitz * width) <= 0.0)
-        small = possible & (width <= resolution)
-        unresolved += int(small.sum())
-        split = (mixed & ~settled) | (possible & ~small)
-        if evaluations + int(split.sum()) > budget:
-            unresolved += int(split.sum())
-            break
-        left, right, middle = left[split], right[split], middle[split]
-        f_left, f_right = f_left[split], f_right[split]
-        if not left.size:
-            break
-        f_middle = distance(middle)
-        evaluations += middle.size
-        left, right = np.concatenate([left, middle]), np.concatenate([middle, right])
-        f_left, f_right = np.concatenate([f_left, f_middle]), np.concatenate([f_middle, f_right])
-    merged = []
-    for start, end in sorted((float(a), float(b)) for a, b in ranges):
-        if merged and start <= merged[-1][1]:
-            merged[-1] = (merged[-1][0], max(merged[-1][1], end))
-        else:
-            merged.append((start, end))
-    return merged, unresolved, evaluations
-
-
-def certified_distance(scene: FclScene, *, lipschitz: float, acceleration: float | None = None,
-                       steps: int = 360, atol: float = 1e-6,
-                       lower: float = 0.0, upper: float = 2.0 * math.pi,
-                       xtol: float = INTERFERENCE_XTOL,
-                       resolution: float = INTERFERENCE_RESOLUTION,
-                       max_evaluations: int = MAX_EVALUATIONS) -> SweepResult:
-    """Certified least distance of the scene's groups over ``[lower, upper]``, and interference.
-
-    Parameters
-    ----------
-    scene : FclScene
-    lipschitz : float
-        Upper bound ``L`` (mm/rad) on ``|d distance / d phi|``: the largest
-        relative speed of any point of group A against any point of group B (see
-        the module notes). The caller's responsibility: too small a bound voids
-        the certificate.
-    acceleration : float, optional
-        Upper bound ``A`` (mm/rad^2) on the relative acceleration of any point of
-        A against any point of B. The distance is then screened to second order,
-        ``d'' <= A + L^2 / d`` (it is the least of point-to-point distances, each
-        obeying that), which a smooth minimum needs: with ``L`` alone the search
-        splits down to intervals of ``2 atol / L`` round it, thousands of poses.
-        A kink (the nearest features switching) needs only ``L``.
-    steps : int
-        Intervals of the screening grid.
-    atol : float
-        The true minimum lies in ``[bound, minimum]`` and ``minimum - bound <= atol``
-        when ``certified``.
-    lower, upper : float
-        Carrier-angle interval (rad); for two arms half a turn apart the
-        distance repeats every ``pi``.
-    xtol : float
-        Tolerance (rad) of the ends of interference ranges.
-    resolution : float
-        Narrowest interval (rad) split in search of an overlap.
-    max_evaluations : int
-        Budget of poses, for the minimum search and again for the interference
-        scan; when spent, ``certified`` is False (or ``unresolved`` counts the
-        intervals left).
-
-    Notes
-    -----
-    Interference is scanned on the screening samples first. An overlap shorter
-    than a step can fall between two samples; the Lipschitz bound rules that
-    out wherever ``d_left + d_right > L h`` (the distance cannot reach 0 in
-    between), so only the remaining intervals are split further (a collide and
-    distance query per midpoint), down to ``resolution``; the ends of each
-    overlap are bisected to ``xtol``. What is left (``unresolved``) are
-    intervals narrower than ``resolution`` in which the distance comes within
-    ``L * resolution / 2`` of 0, next to a range found or at a near touch: an
-    overlap missed there lasts less than ``resolution``. A brief separation
-    inside an overlap (both ends of an interval overlapping) is not looked for:
-    the parts interfere either way. When ``bound > 0`` no overlap exists at all.
-
-    The scan runs first: when it finds an overlap the minimum is 0, certified
-    (the distance is never negative), at the first overlapping pose sampled.
-    """
-    from kinematics.sweep import certified_minimum
-
-    if not (math.isfinite(lipschitz) and lipschitz >= 0.0):
-        raise SolidInputError("lipschitz", f"must be a finite bound >= 0, not {lipschitz!r}")
-    if acceleration is not None and not (math.isfinite(acceleration) and acceleration >= 0.0):
-        raise SolidInputError("acceleration", f"must be a finite bound >= 0, not {acceleration!r}")
-    if not (isinstance(steps, (int, np.integer)) and steps >= 2):
-        raise SolidInputError("steps", f"must be an integer >= 2, not {steps!r}")
-    if not (math.isfinite(lower) and math.isfinite(upper) and upper > lower):
-        raise SolidInputError("interval", f"need finite lower < upper, got [{lower!r}, {upper!r}]")
-    if not (xtol > 0.0 and resolution >= xtol):
-        raise SolidInputError("xtol",
-                              f"need 0 < xtol <= resolution, got {xtol!r} and {resolution!r}")
-    start = time.perf_counter()
-    lipschitz = float(lipschitz)
-    curvature = None if acceleration is None else _curvature(float(acceleration), lipschitz)
-    memo = _Memo(scene)
-    grid = np.linspace(lower, upper, int(steps) + 1)   # certified_minimum's screening grid
-    values = memo(grid)
-    ranges, unresolved, _ = _interference(memo, grid, values, lipschitz, xtol, resolution,
-                                          max_evaluations)
-    if ranges:
-        # the distance is never negative: an overlap is the certified minimum, and
-        # searching on would only split the overlap down to 2 atol / L
-        minimum = bound = 0.0
-        argument = min(phi for phi, near in memo.values.items() if near.overlap)
-    else:
-        found = certified_minimum(memo, lower, upper, steps=int(steps), lipschitz=lipschitz,
-                                  curvature=curvature, atol=atol, max_evaluations=max_evaluations)
-        minimum, argument, bound = found.value, found.argument, max(found.bound, 0.0)
-    near = memo.proximity(argument)
-    return SweepResult(
-        minimum=float(minimum), argument=float(argument), bound=float(bound),
-        certified=bool(minimum - bound <= atol * (1.0 + 1e-9)), evaluations=len(memo.values),
-        point_a=near.point_a, point_b=near.point_b, pair=near.pair,
-        interference_ranges=ranges, unresolved=unresolved, samples_phi=grid,
-        samples_distance=values, lipschitz=lipschitz, acceleration=acceleration, atol=float(atol),
-        seconds=time.perf_counter() - start)
-
-
-def plain_scan(scene: FclScene, poses: int = 3600, *, lower: float = 0.0,
-               upper: float = 2.0 * math.pi) -> tuple:
-    """The sampling-only peer: least distance over ``poses`` evenly spaced carrier angles.
-
-    Returns ``(minimum, argument)`` (mm, rad). No bound: the true minimum may be
-    lower by up to ``L * step / 2``.
-    """
-    if not (isinstance(poses, (int, np.integer)) and poses >= 1):
-        raise SolidInputError("poses", f"must be a positive integer, not {poses!r}")
-    phis = np.linspace(lower, upper, int(poses), endpoint=False)
-    values = scene.distances(phis)
-    best = int(np.argmin(values))
-    return float(values[best]), float(phis[best])

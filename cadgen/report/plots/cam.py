@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cadgen.report.plots.planting import _figure, _fill, _png
+from cadgen.report.plots.base import _figure, _fill, _png
 
 __all__ = ["cam_figures", "cam_figure_jobs"]
 

@@ -1,10 +1,8 @@
-"""The solids stage of a build: parts, enclosure checks, mass properties, STL and assembly files.
+"""What a build's solids came to: the assembly, its housings' enclosure checks, mass properties.
 
-Output under ``solids/``: one binary STL per distinct part in its own frame (a
-part used twice, e.g. by both planting arms, is written once), and the assembly
-(GLB or 3MF) with every instance placed at the chosen carrier angle. The report
-section lists each part's mass properties at the file's density and, per
-housing, whether its gears stay inside the cavity over a revolution.
+The report section lists each part's mass properties at the file's density and, per
+housing, whether its gears stay inside the cavity over a revolution; the files are
+written by :func:`cadgen.export.meshes.write_solids`.
 """
 
 from __future__ import annotations
@@ -13,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "write_solids", "enclosure_checks"]
+__all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "enclosure_checks"]
 
 @dataclass
 class SolidsOutcome:
@@ -100,21 +98,3 @@ def solids_report(outcome: SolidsOutcome) -> dict:
             "enclosure": outcome.enclosure,
             "frames": "each STL in its part's own frame (gears: axis at the origin, faces at "
                       "z = 0 and z = face width); the assembly places every instance"}
-
-
-def write_solids(outcome: SolidsOutcome, staging) -> list:
-    """Write ``solids/<part>.stl`` and ``solids/assembly.<glb|3mf>``; return the relative paths."""
-    from cadgen.export.meshes import assembly_bytes, stl_bytes
-
-    folder = staging / "solids"
-    folder.mkdir()
-    written = []
-    for part in outcome.assembly.parts:
-        (folder / f"{part.name}.stl").write_bytes(stl_bytes(part.mesh))
-        written.append(f"solids/{part.name}.stl")
-    placed = [(name, part.mesh, pose) for name, part, pose
-              in outcome.assembly.placements(outcome.carrier_angle)]
-    (folder / f"assembly.{outcome.file_type}").write_bytes(
-        assembly_bytes(placed, outcome.file_type))
-    written.append(f"solids/assembly.{outcome.file_type}")
-    return written

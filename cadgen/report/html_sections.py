@@ -1,0 +1,291 @@
+"""The HTML report's sections, one function per part of the report.
+
+Each takes the report (a dict, the content of ``report.json``) and returns one
+``<section>`` or "" when the report lacks that part, so reports of either
+mechanism kind, with or without gears, cam, solids, sweep or stage statuses,
+render. :func:`cadgen.report.html.render_html` puts them in page order.
+"""
+
+from __future__ import annotations
+
+from cadgen.report.html_tables import (_badge, _degrees_ranges, _e, _key_values, _number,
+                                       _pass_badge, _point, _problem_list, _quantity, _row,
+                                       _scientific, _section, _split_unit, _table)
+
+__all__ = ["_metrics_section", "_planting_motion_section", "_pricking_section", "_sweep_section",
+           "_gears_section", "_cam_section", "_solids_section", "_stages_section",
+           "_accuracy_section", "_parameters_section", "_sweep_name"]
+
+
+def _sweep_name(key: str, sweep: dict) -> str:
+    """A clearance sweep's name on the page: its label, or its report key in words."""
+    return str(sweep.get("label") or _split_unit(key)[0])
+
+
+# ----------------------------------------------------------------------------------------------
+# mechanism sections
+
+
+def _metrics_section(report: dict) -> str:
+    metrics = report.get("metrics", [])
+    # A clearance the solids' sweep measured keeps the kinematic estimate beside it.
+    estimates = any("kinematic_estimate" in m for m in metrics)
+    rows, classes = [], []
+    for m in metrics:
+        spacing = m.get("spacing_mm")
+        spacing = "" if spacing is None else _quantity(spacing, "mm", trim=True)
+        unit = m.get("unit", "")
+        row = [_e(m["label"]), _e(spacing), _e(_quantity(m["value"], unit)),
+               _e(f"{m['target']} {unit}".strip()),
+               # a search whose gap [bound, value] straddles the target decides nothing
+               _badge("warn").replace("WARN", "UNDECIDED") if m.get("verdict") == "undecided"
+               else _pass_badge(m["passed"])]
+        if estimates:
+            estimate = m.get("kinematic_estimate")
+            row.append(_e("" if estimate is None else _quantity(estimate, unit)))
+        rows.append(row)
+        classes.append("" if m["passed"] else "fail")
+    headers = ["metric", "plant spacing", "value", "target", "result"]
+    body = _table(headers + ["kinematic estimate"] * estimates, rows, numeric=(1, 2, 5),
+                  row_classes=classes)
+    return _section("metrics", "Design metrics against targets", body)
+
+
+def _planting_motion_section(report: dict) -> str:
+    parts = []
+    events = report.get("events")
+    if events:
+        angles, attitude = events.get("carrier_angle_deg", {}), events.get("attitude_deg", {})
+        rows = [[_e(name), _e(_quantity(angles.get(name), "deg", 2)),
+                 _e(_quantity(attitude.get(name), "deg", 2))]
+                for name in dict.fromkeys([*angles, *attitude])]
+        rest = {k: v for k, v in events.items() if k not in ("carrier_angle_deg", "attitude_deg")}
+        parts.append("<h3>Events over one carrier turn</h3>" + _row(
+            _table(["event", "carrier angle", "attitude Ψ"], rows, numeric=(1, 2)),
+            _key_values(rest)))
+    spacings = report.get("per_spacing")
+    if spacings:
+        rows = [[_e(_quantity(s["spacing_mm"], "mm", trim=True)),
+                 _e(_quantity(s["hole_width_mm"], "mm")),
+                 _e(_quantity(s["hole_verticality_mm"], "mm")),
+                 _e(_quantity(s["hole_span_mm"], "mm")),
+                 _e(_number(s["x_entry_mm"], 2)), _e(_number(s["x_exit_mm"], 2)),
+                 _e(_number(s["x_lowest_mm"], 2)),
+                 _e(_point(s["tip_velocity_absolute_lowest_mm_s"], 2) + " mm/s")]
+                for s in spacings]
+        parts.append("<h3>Per plant spacing</h3>" + _table(
+            ["spacing", "hole width", "verticality", "span", "x entry (mm)", "x exit (mm)",
+             "x lowest (mm)", "tip velocity at lowest point"], rows, numeric=tuple(range(8))))
+    if "derived" in report:
+        parts.append("<h3>Derived geometry</h3>" + _key_values(report["derived"]))
+    if not parts:
+        return ""
+    return _section("motion", "Planting motion and derived geometry", "".join(parts))
+
+
+def _pricking_section(report: dict) -> str:
+    field = report.get("field", {})
+    rows, classes = [], []
+    for r in field.get("per_inclination", []):
+        root = r.get("needle_root_in_soil")
+        rows.append([_e(_quantity(r["inclination_deg"], "deg", 1)),
+                     _e(_quantity(r["needle_entry_angle_deg"], "deg", 2)),
+                     _e(_quantity(r["needle_exit_angle_deg"], "deg", 2)),
+                     _e(_quantity(r["hole_mouth_mm"], "mm", 2)),
+                     _e(_quantity(r["time_in_soil_deg"], "deg", 1)),
+                     _e(_degrees_ranges(r.get("slow_windows_deg"))),
+                     _e(_quantity(r["slow_window_total_deg"], "deg", 1)),
+                     _e(_quantity(r["projected_height_mm"], "mm", 1)),
+                     _e(_quantity(r["width_mm"], "mm", 1)),
+                     _badge("fail") + " yes" if root else "no"])
+        classes.append("fail" if root else "")
+    note = (f"carrier at {_number(field.get('carrier_speed_rpm'), trim=True)} r/min, forward "
+            f"speed {_number(field.get('forward_speed_mm_s'), trim=True)} mm/s, depth "
+            f"{_number(field.get('depth_mm'), trim=True)} mm; {field.get('angles', '')}")
+    note = f'<p class="note">{_e(note)}</p>'
+    body = [note, _table(["inclination", "needle entry", "needle exit", "hole mouth", "in soil",
+                          "slow windows", "slow total", "height", "width", "needle root in soil"],
+                         rows, numeric=(0, 1, 2, 3, 4, 6, 7, 8), row_classes=classes)]
+    findings = report.get("findings", [])
+    # Newer reports count findings among their failures; older ones only warn.
+    state = "fail" if "failures" in report else "warn"
+    body.append(f"<h3>Findings ({len(findings)})</h3>"
+                + (_problem_list(findings, state) or '<p class="note">none</p>'))
+    gears = report.get("gears", {})
+    if gears.get("pitch_curves"):
+        rows = [[_e(g["name"]), _e(str(g["stage"])), _e(g["role"]),
+                 _e(_number(g["perimeter_mm"])),
+                 _e(f"{_number(g['radius_min_mm'], 2)}–{_number(g['radius_max_mm'], 2)}"),
+                 _e(_number(g["curvature_min_per_mm"], 4)),
+                 "yes" if g["convex"] else _badge("warn") + " no",
+                 _e(_number(g["pressure_angle_deviation_max_deg"], 1)),
+                 _e(_number(g["convex_radius_of_curvature_min_mm"], 2)),
+                 _badge("warn") + " yes" if g["undercut"] else "no"]
+                for g in gears["pitch_curves"]]
+        body.append("<h3>Pitch curves</h3>" + _table(
+            ["gear", "stage", "role", "perimeter (mm)", "radius (mm)", "min curvature (1/mm)",
+             "convex", "pressure-angle deviation (deg)", "min convex ρ (mm)", "undercut"],
+            rows, numeric=(3, 4, 5, 7, 8)))
+    rest = {k: v for k, v in gears.items() if k != "pitch_curves"}
+    body.append(_row(*(f"<h3>{title}</h3>" + _key_values(data) for title, data in (
+        ("Linkage", report.get("linkage")), ("Gear ratio split", rest),
+        ("Forward check", report.get("verification"))) if data)))
+    return _section("field", "Field behaviour per inclination", "".join(body))
+
+
+def _sweep_section(report: dict) -> str:
+    sweeps = report.get("sweep")
+    if not sweeps:
+        return ""
+    names = list(sweeps)
+    fields = (
+        ("result", lambda s: _pass_badge(s.get("passed"))),
+        ("minimum", lambda s: _e(_quantity(s.get("minimum_mm"), "mm"))),
+        ("certified lower bound", lambda s: _e(_quantity(s.get("certified_bound_mm"), "mm"))),
+        ("target", lambda s: _e("> " + _quantity(s.get("target_mm"), "mm", trim=True))),
+        ("where (carrier angle)",
+         lambda s: _e(_quantity(s.get("carrier_angle_deg"), "deg", 2))),
+        ("nearest parts", lambda s: _e(" ↔ ".join(map(str, s.get("nearest") or [])) or "—")),
+        ("nearest points (mm)",
+         lambda s: _e(" ↔ ".join(_point(p) for p in s.get("nearest_points_mm") or []) or "—")),
+        ("interference ranges",
+         lambda s: _e(_degrees_ranges(s.get("interference_ranges_deg")))),
+        ("kinematic estimate", lambda s: _e(_quantity(s.get("kinematic_estimate_mm"), "mm"))),
+        ("evaluations", lambda s: _e(_number(s.get("evaluations")))),
+        ("method", lambda s: _e(s.get("method", "—"))),
+    )
+    rows = [[_e(label)] + [cell(sweeps[n]) for n in names] for label, cell in fields]
+    headers = ["", *(_sweep_name(n, sweeps[n]) for n in names)]
+    body = _table(headers, rows)
+    return _section("sweep", "Interference and clearance sweep", body)
+
+
+def _gears_section(report: dict) -> str:
+    train = report.get("gear_train")
+    if train is None:
+        return ""
+    rows, problems = [], []
+    for g in train.get("gears", []):
+        cutter = g["cutter"] + (f" (z = {g['shaper_teeth']})" if g.get("shaper_teeth") else "")
+        codes = ", ".join(p["code"] for p in g.get("problems", []))
+        rows.append([_e(g["gear"]), _e(g["stage"]), _e(str(g["teeth"])),
+                     _e(_number(g["module_mm"], 4)), _e(cutter), "yes" if g["convex"] else "no",
+                     _e(str(len(g["undercut_teeth"]))), _e(str(len(g["pointed_teeth"]))),
+                     _e(_number(g["root_thickness_min_mm"])),
+                     _e(_number(g["tip_thickness_min_mm"])),
+                     _badge("warn") + " " + _e(codes) if codes else "—"])
+        problems += g.get("problems", [])
+    body = [_table(["gear", "stage", "teeth", "module (mm)", "cutter", "convex", "undercut teeth",
+                    "pointed teeth", "min root thickness (mm)", "min tip thickness (mm)",
+                    "problems"], rows, numeric=(2, 3, 6, 7, 8, 9))
+            if rows else '<p class="note">no gears were cut</p>']
+    body.append(_problem_list(problems, "warn"))
+    mesh_rows, classes = [], []
+    for m in train.get("meshes", []):
+        relief = m.get("tip_relief")
+        relief_text = (f"{relief['gear']}: {_number(relief['removed_area_mm2'])} mm², "
+                       f"{_number(relief['depth_mm'])} mm deep" if relief else "—")
+        low, high = m["backlash_deg"]
+        mesh_rows.append([_e(m["stage"]), _e(" / ".join(m["gears"])),
+                          _e(_number(m["centre_distance_mm"])),
+                          _e(f"{m['interference_poses']} of {m['poses']}"),
+                          _e(_scientific(m["overlap_area_max_mm2"])),
+                          _e(f"{_scientific(low)}–{_scientific(high)}"),
+                          _e(_scientific(m["transmission_error_pp_deg"])), _e(relief_text)])
+        classes.append("fail" if m["interference_poses"] else "")
+    if mesh_rows:
+        body.append("<h3>Meshes</h3>" + _table(
+            ["stage", "gears", "centre distance (mm)", "interfering poses",
+             "largest overlap (mm²)", "backlash (deg)", "transmission error p-p (deg)",
+             "tip relief"],
+            mesh_rows, numeric=(2, 3, 4, 5, 6), row_classes=classes))
+    failures = train.get("failures", [])
+    if failures:
+        body.append(f"<h3>Gears not cut ({len(failures)})</h3>" + _problem_list(failures))
+    return _section("gears", "Gears", "".join(body))
+
+
+def _cam_section(report: dict) -> str:
+    cam = report.get("cam")
+    if cam is None:
+        return ""
+    state = "pass" if cam.get("cuttable", True) and not cam.get("problems") else "fail"
+    shown = {k: v for k, v in cam.items() if k != "problems"}
+    verdict = "the roller can follow the contour" if state == "pass" else "cam problems below"
+    body = (f"<p>{_badge(state)} {verdict}</p>"
+            + _key_values(shown) + _problem_list(cam.get("problems", [])))
+    return _section("cam", "Duckbill cam", body)
+
+
+def _solids_section(report: dict) -> str:
+    solids = report.get("solids")
+    if solids is None:
+        return ""
+    rows = [[_e(p["part"]), _e(p["kind"]), _e(str(p["instances"])),
+             _e(_number(p["volume_mm3"], 0)), _e(_number(p["mass_kg"])),
+             _e(_point(p["centre_of_mass_mm"], 2)), _e(str(p.get("triangles", "—"))),
+             _pass_badge(p.get("watertight", True))]
+            for p in solids.get("parts", [])]
+    assembly = solids.get("assembly", {})
+    body = [f'<p>total mass {_e(_quantity(solids.get("total_mass_kg"), "kg"))} at density '
+            f'{_e(_number(solids.get("density_kg_m3"), trim=True))} kg/m³; assembly '
+            f'<code>{_e(assembly.get("file", "—"))}</code> at carrier angle '
+            f'{_e(_number(assembly.get("carrier_angle_deg"), trim=True))} deg</p>',
+            _table(["part", "kind", "instances", "volume (mm³)", "mass each (kg)",
+                    "centre of mass (mm)", "triangles", "watertight"], rows,
+                   numeric=(2, 3, 4, 6))]
+    enclosure, classes = [], []
+    for r in solids.get("enclosure", []):
+        ok = r.get("gears_enclosed", True) and r.get("axial_fit", True)
+        margin = r.get("smallest_margin_mm")
+        enclosure.append([_e(r["housing"]), _pass_badge(r.get("gears_enclosed")),
+                          _e(_quantity(margin, "mm") if margin is not None else
+                             "coarse estimate (no gears cut)"),
+                          _e(r.get("nearest_gear") or "—"), _pass_badge(r.get("axial_fit"))])
+        classes.append("" if ok else "fail")
+    if enclosure:
+        body.append("<h3>Enclosure</h3>" + _table(
+            ["housing", "encloses its gears", "smallest margin", "nearest gear", "axial fit"],
+            enclosure, numeric=(2,), row_classes=classes))
+    if solids.get("frames"):
+        body.append(f'<p class="note">{_e(solids["frames"])}</p>')
+    return _section("solids", "Solids", "".join(body))
+
+
+def _stages_section(report: dict) -> str:
+    if "stages" in report:
+        stages = report["stages"]
+    else:
+        stages = [{"stage": k, "seconds": v} for k, v in report.get("stages_s", {}).items()]
+    if not stages:
+        return ""
+    with_status = any("status" in s for s in stages)
+    rows, classes = [], []
+    for s in stages:
+        row = [_e(s["stage"]), _e(_number(s.get("seconds"), 3))]
+        if with_status:
+            status = s.get("status", "ok")
+            badge = {"ok": "pass", "failed": "fail"}.get(status, "warn")
+            row += [f'<span class="badge {badge}">{_e(status)}</span>', _e(s.get("message", ""))]
+        rows.append(row)
+        classes.append("fail" if s.get("status") == "failed" else "")
+    total = sum(float(s.get("seconds") or 0.0) for s in stages)
+    rows.append(["<b>total</b>", f"<b>{_e(_number(total))}</b>"] + ["", ""][: 2 * with_status])
+    classes.append("")
+    headers = ["stage", "seconds"] + (["status", "message"] if with_status else [])
+    return _section("stages", "Stages", _table(headers, rows, numeric=(1,), row_classes=classes))
+
+
+def _accuracy_section(report: dict) -> str:
+    if not report.get("accuracy"):
+        return ""
+    # More digits than elsewhere: here the point is how far apart value and bound are.
+    return _section("accuracy", "Accuracy achieved", _key_values(report["accuracy"], digits=9))
+
+
+def _parameters_section(report: dict) -> str:
+    if not report.get("parameters"):
+        return ""
+    return _section("parameters", "Input parameters",
+                    f"<details><summary>show the validated parameters</summary>"
+                    f"{_key_values(report['parameters'])}</details>")

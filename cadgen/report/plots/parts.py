@@ -1,0 +1,131 @@
+"""Pictures of the parts: the assembled solids (front view at the assembly's pose), each
+gear pair at the start position, and the clearances over the FCL sweep."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from cadgen.report.plots.base import _figure, _fill, _png
+from kinematics.planar import cross
+
+__all__ = ["assembly_view", "pair_figure_jobs", "pair_figures", "clearance_figure"]
+
+
+_COLOURS = {"ground": "#b5895a", "housing": "#8fa3b8", "gear": "#d9a441", "cam": "#7a9e7e",
+            "planter": "#6d7f99", "blade": "#4f5d73", "rocker": "#6d7f99", "needle": "#3b4657"}
+
+
+def _silhouette(part, pose):
+    """The part's outline in the world's xy plane: its section for prisms, else its triangles'
+    projections merged (shapely)."""
+    import shapely
+
+    if part.outline is not None:
+        outline = np.asarray(part.outline) @ pose[:2, :2].T + pose[:2, 3]
+        return shapely.Polygon(outline)
+    triangles = part.mesh.triangles @ pose[:3, :3].T + pose[:3, 3]
+    flat = triangles[:, :, :2]
+    area = np.abs(cross(flat[:, 1] - flat[:, 0], flat[:, 2] - flat[:, 0]))
+    return shapely.union_all(shapely.polygons(flat[area > 1e-9]))
+
+
+def assembly_view(assembly, angle: float, *, title: str, paths=(), soil_level=None) -> bytes:
+    """Front view of every placed part at carrier angle ``angle`` (rad), drawn from the back
+    layer to the front one, with optional reference paths ``[(xy (n, 2), label)]``."""
+    import shapely
+
+    figure, ax = _figure(7.0, 8.0)
+    placed = []
+    for name, part, pose in assembly.placements(angle):
+        depth = float((part.mesh.bounds[1, 2] + pose[2, 3]) if part.kind != "ground" else -np.inf)
+        placed.append((depth, name, part, pose))
+    for depth, name, part, pose in sorted(placed, key=lambda item: item[0]):
+        shape = _silhouette(part, pose)
+        polygons = getattr(shape, "geoms", [shape])
+        for polygon in polygons:
+            if polygon.is_empty or not isinstance(polygon, shapely.Polygon):
+                continue
+            x, y = polygon.exterior.xy
+            _fill(ax, x, y, color=_COLOURS.get(part.kind, "0.6"), ec="k", lw=0.3, alpha=0.95)
+            for ring in polygon.interiors:
+                _fill(ax, *ring.xy, color="white", ec="k", lw=0.3)
+    for xy, label in paths:
+        ax.plot(xy[:, 0], xy[:, 1], "k--", lw=0.8, label=label)
+    if soil_level is not None:
+        ax.axhline(soil_level, color="saddlebrown", lw=1.0, label="soil surface")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm, forward travel)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(title, fontsize=9)
+    if paths or soil_level is not None:
+        ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.2)
+    return _png(figure)
+
+# ----------------------------------------------------------------------------------------------
+# Gear pairs at the start position
+
+def pair_figure_jobs(train) -> dict:
+    """``{file name: callable -> PNG bytes}``: a picture of each pair at the start position."""
+    jobs = {}
+    for index, stage in enumerate(train.stages):
+        slug = re.sub(r"[^a-z0-9]+", "-", stage.name.lower()).strip("-")
+        jobs[f"gears-{index + 1}-{slug}.png"] = lambda stage=stage: _pair_figure(stage)
+    return jobs
+
+
+def pair_figures(train) -> dict:
+    """A picture of each pair at the start position (PNG bytes, keyed by file name)."""
+    return {name: draw() for name, draw in pair_figure_jobs(train).items()}
+
+
+def _pair_figure(stage) -> bytes:
+    figure, ax = _figure(8.0, 5.0)
+    pair = stage.generated.pair
+    rotations = pair.rotations(np.array([0.0]))
+    for k, (profile, check) in enumerate(zip(stage.generated.profiles, stage.generated.checks)):
+        outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
+        _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
+              f"({profile.teeth} teeth, {check.cutter})")
+        ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
+    m = stage.meshing
+    ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
+                 f"{m.interference_poses} interfering poses of {m.poses}, "
+                 f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
+    ax.set_aspect("equal")
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.2)
+    return _png(figure)
+
+# ----------------------------------------------------------------------------------------------
+# Clearances over the sweep
+
+def clearance_figure(sweeps: dict) -> bytes:
+    """Minimum distance between the solids vs carrier angle, per sweep, the minimum and target
+    marked, interference ranges shaded."""
+    figure, ax = _figure(8.0, 4.5)
+    colours = {"arm_interference": "tab:blue", "ground_clearance": "tab:brown"}
+    for key, sweep in sweeps.items():
+        samples = sweep["samples"]
+        colour = colours.get(key, "k")
+        ax.plot(samples["carrier_angle_deg"], samples["distance_mm"], color=colour,
+                label=sweep["label"])
+        ax.axhline(sweep["target_mm"], color=colour, ls=":", lw=1.0,
+                   label=f"target > {sweep['target_mm']:g} mm")
+        ax.plot([sweep["carrier_angle_deg"]], [sweep["minimum_mm"]], "o", color=colour)
+        ax.annotate(f"{sweep['minimum_mm']:.2f} mm", (sweep["carrier_angle_deg"],
+                                                      sweep["minimum_mm"]),
+                    textcoords="offset points", xytext=(5, 5), fontsize=8, color=colour)
+        for start, end in sweep.get("interference_ranges_deg") or []:
+            ax.axvspan(start, end, color="red", alpha=0.2)
+    ax.set_xlim(0, 360)
+    ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
+    ax.set_xlabel("carrier angle (deg, 0 = catching)")
+    ax.set_ylabel("minimum distance between the solids (mm)")
+    ax.set_title("Clearances of the solids over a revolution (FCL, certified minimum marked)",
+                 fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return _png(figure)

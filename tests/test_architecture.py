@@ -1,0 +1,120 @@
+"""The layout of docs/architecture.md holds: what each package may import, module sizes, the API.
+
+Read from the source with ``ast`` (imports inside functions included), so a new import that
+points the wrong way fails here rather than in a review.
+"""
+
+import ast
+import importlib.resources
+from pathlib import Path
+
+import pytest
+
+import cadgen
+
+REPO = Path(__file__).resolve().parents[1]
+
+#: Each unit and the units it may import (besides itself), lowest floor first. A unit is a
+#: package under cadgen/, a top-level module, ``kinematics``, or ``cadgen.params.feasibility``:
+#: the design checks a file gets at load time run the models, so that one module of params
+#: sits above them (it imports them inside its functions).
+ALLOWED = {
+    "kinematics": set(),
+    "cadgen.geometry": set(),
+    # loading calls the design checks, inside a function (see cadgen.params.feasibility)
+    "cadgen.params": {"kinematics", "cadgen.params.feasibility"},
+    "cadgen.gears": {"kinematics"},
+    "cadgen.cam": {"kinematics"},
+    "cadgen.solids": {"kinematics", "cadgen.params", "cadgen.geometry", "cadgen.gears"},
+    "cadgen.design": {"kinematics", "cadgen.solids"},
+    "cadgen.sweep": {"kinematics", "cadgen.solids"},
+    "cadgen.params.feasibility": {"kinematics", "cadgen.params", "cadgen.design", "cadgen.cam"},
+    "cadgen.export": {"kinematics", "cadgen.geometry", "cadgen.gears", "cadgen.solids"},
+    "cadgen.report": {"kinematics", "cadgen", "cadgen.cam", "cadgen.export", "cadgen.gears",
+                      "cadgen.solids"},
+    "cadgen.pipeline": {"kinematics", "cadgen.params", "cadgen.params.feasibility",
+                        "cadgen.geometry", "cadgen.gears", "cadgen.cam", "cadgen.solids",
+                        "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report"},
+    "cadgen.batch": {"kinematics", "cadgen.params", "cadgen.export", "cadgen.pipeline"},
+    "cadgen.cli": {"cadgen"},        # the command line uses the public API only
+    "cadgen.__main__": {"cadgen.cli"},
+    "cadgen": set(),                 # the API imports lazily, by name (see its _EXPORTS)
+}
+MAX_LINES = 600
+MAX_TOP_LEVEL_MODULES = 6
+
+
+def unit_of(module: str) -> str:
+    if module.startswith("kinematics"):
+        return "kinematics"
+    if module.startswith("cadgen.params.feasibility"):
+        return "cadgen.params.feasibility"
+    parts = module.split(".")
+    return ".".join(parts[:2]) if len(parts) > 1 else "cadgen"
+
+
+def sources():
+    for path in sorted((REPO / "cadgen").rglob("*.py")) + sorted((REPO / "kinematics").rglob("*.py")):
+        module = ".".join(path.relative_to(REPO).with_suffix("").parts).removesuffix(".__init__")
+        yield module, path
+
+
+def imports_of(path: Path):
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            yield node.module
+        elif isinstance(node, ast.ImportFrom) and node.level:
+            yield "kinematics" if "kinematics" in path.parts else "cadgen.?relative"
+        elif isinstance(node, ast.Import):
+            yield from (alias.name for alias in node.names)
+
+
+def test_every_import_points_down_the_floors():
+    wrong = []
+    for module, path in sources():
+        unit = unit_of(module)
+        assert unit in ALLOWED, f"{module}: a new package; give it a floor in ALLOWED and the doc"
+        for imported in imports_of(path):
+            if imported.split(".")[0] not in ("cadgen", "kinematics"):
+                continue
+            other = unit_of(imported)
+            if other != unit and other not in ALLOWED[unit]:
+                wrong.append(f"{module} imports {imported} ({unit} -> {other})")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_kinematics_never_imports_cadgen():
+    for module, path in sources():
+        if module.startswith("kinematics"):
+            assert not [m for m in imports_of(path) if m.startswith("cadgen")], module
+
+
+@pytest.mark.parametrize("module, path", list(sources()), ids=lambda v: str(v))
+def test_no_module_is_over_the_style_guides_size(module, path):
+    lines = len(path.read_text(encoding="utf-8").splitlines())
+    assert lines <= MAX_LINES, f"{module}: {lines} lines; split it by concept"
+
+
+def test_the_top_level_holds_the_cli_main_and_the_api_only():
+    top = sorted(p.name for p in (REPO / "cadgen").glob("*.py"))
+    assert len(top) <= MAX_TOP_LEVEL_MODULES, top
+    assert {"__init__.py", "__main__.py", "cli.py"} <= set(top)
+
+
+def test_every_public_name_resolves_and_the_cli_needs_nothing_else():
+    for name in cadgen.__all__:
+        assert getattr(cadgen, name) is not None, name
+    # the names the command line takes from the API are all public
+    tree = ast.parse((REPO / "cadgen" / "cli.py").read_text(encoding="utf-8"))
+    taken = {alias.name for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
+             and node.module == "cadgen" for alias in node.names}
+    assert taken - {"__version__"} <= set(cadgen.__all__)
+    assert {"load_params", "build", "evaluate", "ParameterError", "MechanismError"} <= set(
+        cadgen.__all__)
+
+
+def test_the_report_page_template_and_css_are_package_data():
+    files = importlib.resources.files("cadgen.report")
+    assert "<style>" not in (REPO / "cadgen" / "report" / "html.py").read_text(encoding="utf-8")
+    assert files.joinpath("report.css").read_text(encoding="utf-8").strip()
+    assert "${" in files.joinpath("page.html").read_text(encoding="utf-8")
