@@ -39,12 +39,19 @@ _EXPORTS = {
     "MECHANISM_KINDS": "cadgen.params",
     "STEPS_PER_REVOLUTION_RANGE": "cadgen.params",
     "EFFECTS": "cadgen.params.scene",
+    # starting files from the bundled designs (cadgen new)
+    "TEMPLATES": "cadgen.params.templates",
+    "template_text": "cadgen.params.templates",
+    "write_template": "cadgen.params.templates",
     # evaluating a design (nothing written) and building it (files written)
     "evaluate": "cadgen.design",
     "build": "cadgen.pipeline.build",
     "BuildResult": "cadgen.pipeline.build",
     "check_output_root": "cadgen.export.atomic",
     "run_analysis": "cadgen.pipeline.build",
+    # a build's progress as it runs: the events, and the printer the command line uses
+    "ProgressEvent": "cadgen.pipeline.progress",
+    "ProgressPrinter": "cadgen.report.progress",
     # many designs
     "run_batch": "cadgen.batch",
     "expand_grid": "cadgen.batch",

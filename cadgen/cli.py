@@ -1,4 +1,5 @@
-"""Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``) and ``cadgen batch``.
+"""Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``), ``cadgen batch``
+and ``cadgen new`` (a starting parameter file).
 
 Exit codes (every command):
 
@@ -116,11 +117,14 @@ def _cmd_build(args: argparse.Namespace) -> int:
         return EXIT_PROBLEMS
 
     import cadgen
-    from cadgen import OutputDirError
+    from cadgen import OutputDirError, ProgressPrinter
 
+    # stages as they start and end, on stderr: stdout keeps the summary
     try:
-        result = cadgen.build(params, output_root=Path(args.output_dir), effects=args.effects,
-                              case=args.case, steps=args.steps, preset=args.preset)
+        with ProgressPrinter(sys.stderr) as printer:
+            result = cadgen.build(params, output_root=Path(args.output_dir),
+                                  effects=args.effects, case=args.case, steps=args.steps,
+                                  preset=args.preset, progress=printer)
     except OutputDirError:
         raise                       # main() says it, the same way for every command
     except MechanismError as exc:   # stages report their own failures; this is anything else
@@ -188,7 +192,40 @@ def build_parser() -> argparse.ArgumentParser:
         "parameters, in local processes or on a Dask cluster; keep going past failing "
         "designs; write a summary CSV and HTML table; exit 1 if any design failed.")
     add_batch_arguments(batch)
+
+    new = commands.add_parser(
+        "new", help="write a commented starting parameter file from a bundled design",
+        description="Write a commented starting parameter file NAME.toml (or --output FILE) "
+        "for a planting mechanism (the paper's design) or a pricking mechanism (kernel-b, "
+        "convex gears), with its name set to NAME. Never overwrites a file (exit 2).")
+    new.add_argument("kind", choices=("planting", "pricking"), help="mechanism kind")
+    new.add_argument("name", metavar="NAME", help="design name (also its output folder)")
+    new.add_argument("--output", "-o", metavar="FILE", default=None,
+                     help="the file to write (default: NAME.toml)")
+    new.set_defaults(handler=_cmd_new)
     return parser
+
+
+def _cmd_new(args: argparse.Namespace) -> int:
+    from cadgen import ParameterError, write_template
+
+    try:
+        path = write_template(args.kind, args.name, args.output)
+    except ParameterError as exc:
+        for problem in exc.problems:
+            print(f"cadgen new: {problem}", file=sys.stderr)
+        return EXIT_PROBLEMS
+    except FileExistsError as exc:
+        print(f"cadgen new: {exc.filename or args.output} exists; not overwritten (choose "
+              "another NAME or --output FILE)", file=sys.stderr)
+        return EXIT_PROBLEMS
+    except OSError as exc:
+        print(f"cadgen new: cannot write {exc.filename or args.output}: {exc.strerror or exc}",
+              file=sys.stderr)
+        return EXIT_PROBLEMS
+    print(f"wrote {path} ({args.kind}, from the bundled example); next: "
+          f"cadgen validate {path} && cadgen build {path}")
+    return EXIT_OK
 
 
 def _one_line(text: str, limit: int = _MESSAGE_CHARACTERS) -> str:

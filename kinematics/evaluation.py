@@ -182,12 +182,15 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         "refine_xatol_rad": tol.REFINE_XATOL,
         "steps_per_revolution": steps,
         "minimum_searches": {
-            name: {"value": r.value, "certified_bound": r.bound, "certified": r.certified,
+            # the highest point is searched as the minimum of -y: reported as the height it
+            # is, its certified bound then an upper one ("maximum": True)
+            name: {"value": sign * r.value, "certified_bound": sign * r.bound,
+                   "maximum": sign < 0, "certified": r.certified,
                    "gap": r.gap, "atol": r.atol, "budget_spent": r.budget_spent,
                    "refined_intervals": r.refined_intervals, "evaluations": r.evaluations}
-            for name, r in (("lowest_point", events.lowest_search),
-                            ("highest_point", events.highest_search),
-                            ("arm_distance", arms), ("ground_clearance", clearance))},
+            for name, r, sign in (("lowest_point", events.lowest_search, 1.0),
+                                  ("highest_point", events.highest_search, -1.0),
+                                  ("arm_distance", arms, 1.0), ("ground_clearance", clearance, 1.0))},
     }
     return PlantingEvaluation(
         metrics=metrics, events=events, holes=holes, attitudes_deg=attitudes, speeds=speeds,

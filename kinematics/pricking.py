@@ -225,12 +225,16 @@ def _findings(stages, curve):
                     f"needs a shaper cutter of pitch radius below {1 / -gear.curvature_min:.1f} mm; "
                     f"or {advice}"))
             if gear.undercut:
+                # a prediction for rack cutting, so a warning: the cut teeth's measured root
+                # thickness (the gear checks of stage teeth) decides whether it fails
                 notes.append(Problem(
                     f"gears.{gear.name.replace(' ', '_')}", "undercut",
                     f"the {gear.name} gear's pitch curve bends to a radius of curvature of "
                     f"{gear.convex_radius_of_curvature_min:.2f} mm, below the rack undercut limit "
-                    f"{gear.undercut_limit:.2f} mm (m ha*/sin^2 alpha): rack-cut teeth would be "
-                    "undercut; use a smaller module, a profile shift or a shaper cutter"))
+                    f"{gear.undercut_limit:.2f} mm (m ha*/sin^2 alpha): rack-cut teeth are "
+                    "predicted to be undercut there (a warning; the cut teeth's root thickness, "
+                    "checked in stage teeth, decides); a smaller module, a profile shift or a "
+                    "shaper cutter would avoid it", stage="teeth"))
     return notes
 
 

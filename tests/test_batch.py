@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import html
 import io
 import json
 import os
@@ -331,6 +332,132 @@ def test_summary_is_deterministic(three_files, tmp_path):
     assert page.startswith("<!DOCTYPE html>") and "<script" not in page and "http" not in page
 
 
+# --------------------------------------------------------------------------- the HTML page
+
+
+def html_grid_build(params, output_root, **kwargs):
+    """Design ...-002 fails with a DesignError; the others build their metrics and report."""
+    if params.name.endswith("-002"):
+        raise DesignError([Problem("planter.L2", "collides", "the arm hits the housing")])
+    from cadgen.pipeline.build import build
+
+    return build(params, output_root=output_root, effects=["metrics", "report"])
+
+
+@pytest.fixture(scope="module")
+def html_grid(tmp_path_factory):
+    """A 2 x 2 grid (train.R x planter.L2), one design failed, the others with report.html."""
+    directory = tmp_path_factory.mktemp("html")
+    grid = write_grid(directory, '[grid]\n"train.R" = [35.0, 36.0]\n'
+                                 '"planter.L2" = [185.0, 195.0]\n')
+    root = directory / "out"
+    summaries = run_batch(expand_grid(grid), root, workers=2, build=html_grid_build)
+    _, html_path = write_summary(summaries, root)
+    return root, summaries, html_path.read_text(encoding="utf-8")
+
+
+def cells(page: str, row_of: str) -> list[str]:
+    """The cell texts (tags removed) of the design row of ``row_of``."""
+    import re
+
+    row = re.search(rf'<tr class="design[^"]*"><td class="name">(?:<a [^>]*>)?{row_of}<.*?</tr>',
+                    page).group(0)
+    return [re.sub(r"<[^>]+>", "", cell) for cell in re.findall(r"<td[^>]*>(.*?)</td>", row)]
+
+
+def test_html_links_every_built_design_to_its_report(html_grid):
+    import re
+
+    root, summaries, page = html_grid
+    links = re.findall(r'<a href="([^"]+)">([^<]+)</a>', page)
+    assert links == [("r-sweep-001/report.html", "r-sweep-001"),
+                     ("r-sweep-003/report.html", "r-sweep-003"),
+                     ("r-sweep-004/report.html", "r-sweep-004")]
+    for href, name in links:
+        report = root / href
+        assert report.is_file() and f"{name}" in report.read_text(encoding="utf-8")
+    assert '<td class="name">r-sweep-002</td>' in page   # not built: no link
+
+
+def test_html_numbers_rounded_and_failure_under_its_design(html_grid):
+    import re
+
+    _, summaries, page = html_grid
+    numbers = re.findall(r'<td class="num[^"]*"[^>]*>([^<]*)</td>', page)
+    assert len(numbers) == 4 * (2 + 12)   # 2 grid values and 12 metrics a design
+    assert sum(n == "" for n in numbers) == 12   # the design that was not built
+    assert all(re.fullmatch(r"-?\d+(\.\d{1,3})?", n) for n in numbers if n), numbers
+    first = {s["name"]: s for s in summaries}["r-sweep-001"]
+    row = cells(page, "r-sweep-001")
+    assert row[:4] == ["r-sweep-001", "passed", "35", "185"]
+    values = [m["value"] for m in first["metrics"].values()]
+    assert len(row) == 4 + len(values)
+    for text, value in zip(row[4:], values):   # 3 significant digits, at most 3 decimals
+        assert float(text) == pytest.approx(value, rel=5e-3, abs=5e-4)
+    assert row[4] == f"{first['metrics']['trajectory_height']['value']:.0f}"
+    # the failure: a full-width row right under its design, wrapped, not a wide column
+    failed = re.search(r'<td class="name">r-sweep-002</td>.*?</tr>\n<tr class="reason failed">'
+                       r'<td colspan="(\d+)">([^<]*)</td></tr>', page)
+    assert failed and failed.group(2) == "planter.L2: the arm hits the housing [collides]"
+    assert int(failed.group(1)) == 4 + 12
+    assert "1 failed" in page and "4 designs: 3 built" in page
+
+
+def png_pixels(data: bytes):
+    import numpy as np
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(data)).convert("RGB")).astype(int)
+
+
+def has_colour(pixels, rgb, tolerance=12) -> bool:
+    import numpy as np
+
+    return bool((np.abs(pixels - np.array(rgb)).max(axis=2) <= tolerance).any())
+
+
+def test_html_plots_every_metric_against_every_grid_key_with_targets(html_grid):
+    import base64
+    import re
+
+    _, summaries, page = html_grid
+    figures = re.findall(r'<img src="data:image/png;base64,([^"]+)" alt="([^"]+)">', page)
+    metrics = list(summaries[0]["metrics"])
+    assert len(metrics) == 12
+    assert [html.unescape(alt) for _, alt in figures] == [
+        f"{m} against {k}; target {summaries[0]['metrics'][m]['target']}"
+        for m in metrics for k in ("train.R", "planter.L2")]
+    plots = {html.unescape(alt): png_pixels(base64.b64decode(data)) for data, alt in figures}
+    for alt, pixels in plots.items():
+        assert pixels.shape[1] == 540   # 3.6 in at 150 dpi
+        assert has_colour(pixels, (0xc0, 0, 0))   # the design that was not built, a red cross
+    # a range target as a band (green, alpha 0.12 on white), a bound as a dashed green line
+    band = (round(255 - 0.12 * (255 - 0x2a)), round(255 - 0.12 * (255 - 0x9d)),
+            round(255 - 0.12 * (255 - 0x2a)))
+    assert has_colour(plots["hole_width@150mm against train.R; target 0-30"], band, 3)
+    line = plots["trajectory_height against planter.L2; target > 500"]
+    assert has_colour(line, (0x2a, 0x9d, 0x2a), 20) and not has_colour(line, band, 3)
+
+
+def test_html_of_files_has_no_plots_and_shows_every_problem(three_files):
+    _, summaries, _, _, page = three_files
+    assert "data:image/png" not in page and "Metrics against the grid" not in page
+    assert "<a href" not in page   # the fast builds wrote no report.html
+    bad = [s for s in summaries if not s["ok"]][0]
+    assert html.escape(f"{Problem(**bad['failure']['problems'][0])}") in page
+    assert "params/kernel-a.toml" in page   # several sources: under each name
+
+
+def test_format_number():
+    from cadgen.batch.html import format_number, parse_target
+
+    assert [format_number(v) for v in (692.087, 2.733, 0.07342, 185.0, 3, -12.345, 2.1e-05,
+                                       0.0, None, "x")] == [
+        "692", "2.73", "0.073", "185", "3", "-12.3", "2.1e-05", "0", "", "x"]
+    assert [parse_target(t) for t in ("0-20", "> 10", "< 10", "= 1", "about 3", None)] == [
+        (0.0, 20.0), (10.0, None), (None, 10.0), (1.0, 1.0), None, None]
+
+
 def test_a_crashing_build_leaves_nothing_and_the_batch_goes_on(tmp_path):
     grid = write_grid(tmp_path, '[grid]\n"train.R" = [35.0, 36.0, 37.0]\n')
     out = tmp_path / "out"
@@ -563,3 +690,17 @@ def test_a_grid_file_nested_too_deep_is_a_problem_not_a_crash(tmp_path):
     with pytest.raises(GridError) as caught:
         expand_grid(grid)
     assert {p.code for p in caught.value.problems} == {"too_deep"}
+
+
+def test_progress_on_a_terminal_shows_running_and_queued_in_place():
+    stream = io.StringIO()
+    progress = Progress(4, stream, tty=True)
+    progress.started("r-001")
+    progress.started("r-002")
+    progress.update(summary_of("r-001", True))
+    progress.close()
+    text = stream.getvalue()
+    assert text.count("\n") == 1 and text.endswith("\n")       # redrawn in place, then ended
+    assert text.split("\r\x1b[K")[2] == "[0/4] 0% ok 0, failed 0, 2 running (r-001, -002), 2 queued"
+    assert text.split("\r\x1b[K")[-1].startswith("[1/4] 25% ok 1, failed 0, 1 running (r-002), "
+                                                 "2 queued, eta ")

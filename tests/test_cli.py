@@ -126,9 +126,11 @@ def fake_analysis(monkeypatch):
     calls = []
     module = types.SimpleNamespace(fail=None, calls=calls)
 
-    def build(params, *, output_root, effects=None, case=None, steps=None, preset=None):
+    def build(params, *, output_root, effects=None, case=None, steps=None, preset=None,
+              progress=None):
         calls.append({"params": params, "output_root": output_root, "steps": steps,
-                      "effects": effects, "case": case, "preset": preset})
+                      "effects": effects, "case": case, "preset": preset,
+                      "progress": progress})
         if module.fail:
             raise module.fail
         return _FakeResult()
@@ -290,7 +292,12 @@ def test_keyboard_interrupt_during_a_real_build_leaves_no_folder(tmp_path, monke
     (out / "xin2024-planter" / "previous.txt").write_text("kept")
     assert main(["build", str(REFERENCE), "--output-dir", str(out),
                  "--effects", "metrics,solids"]) == EXIT_INTERRUPTED
-    assert capsys.readouterr().err == "cadgen: interrupted\n"
+    # the stages that ran, as plain progress lines (stderr is not a terminal), then one line
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[-1] == "cadgen: interrupted"
+    assert [line.split("] ", 1)[1] for line in lines[:-1] if "started" in line] == [
+        "kinematics: started", "metrics: started", "cam: started", "parts: started"]
+    assert all(line.startswith("[") for line in lines[:-1])
     assert sorted(p.name for p in out.iterdir()) == ["xin2024-planter"]
     assert (out / "xin2024-planter" / "previous.txt").read_text() == "kept"
 

@@ -74,7 +74,12 @@ def test_attitude_difference_is_exit_minus_entry(evaluation):
 def test_every_search_is_certified(evaluation):
     for name, search in evaluation.accuracy["minimum_searches"].items():
         assert search["certified"], name
-        assert search["certified_bound"] <= search["value"]
+        if search["maximum"]:   # the highest point: a height, bounded from above
+            assert search["value"] <= search["certified_bound"]
+        else:
+            assert search["certified_bound"] <= search["value"]
+    highest = evaluation.accuracy["minimum_searches"]["highest_point"]
+    assert highest["value"] == pytest.approx(evaluation.events.highest_height, abs=1e-9)
 
 
 def test_targets_decide_pass_and_fail(paper_mechanism):

@@ -334,7 +334,9 @@ def test_report_failures_decide_the_verdict(planting):
     page = render_html(report, {})
     header = page[page.index("<header>"): page.index("</header>")]
     assert 'verdict fail">FAIL<' in header and html.escape(report["failures"][0]) in header
-    assert dict((name, ok) for name, ok, _ in overall_checks(report))["report verdict"] is False
+    # a failure without a row of its own gets one, named by its cause (no "report verdict")
+    assert dict((name, ok) for name, ok, _ in overall_checks(report))[report["failures"][0]] \
+        is False
     table = rows(section(page, "metrics"))
     assert table[0][-1] == "kinematic estimate"
     assert table[1][-1] == "99.500 mm" and table[2][-1] == ""
@@ -363,13 +365,127 @@ def test_rejects_figures_that_are_not_png(planting):
 
 
 @pytest.mark.parametrize("name, caption", [
-    ("tip_velocity.png", "Tip velocity"),
-    ("gears-3-train-1-sun-to-idler-1.png", "Gear pair 3: train 1 sun to idler 1"),
+    ("tip_velocity.png", "Tip speed, relative and absolute"),
+    ("gears-3-train-1-sun-to-idler-1.png", "Gear pair 3: train 1: sun to idler 1"),
+    ("gears-2-1-1-pair-d-to-e.png", "Gear pair 2: 1:1 pair D to E"),
+    ("gears-1-non-circular-pair.png", "Gear pair 1: non-circular pair"),
+    ("gears-2-stage-2.png", "Gear pair 2: stage 2"),
     ("cam-contour.png", "Cam contour"),
-    ("clearance.png", "Clearance"),
-], ids=["underscores", "gear-pair", "dashes", "sweep"])
+    ("clearance.png", "Clearances of the solids (FCL sweep)"),
+    ("my_other-plot.png", "My other plot"),
+], ids=["known", "train", "one-to-one", "non-circular", "stage", "dashes", "sweep", "unknown"])
 def test_figure_caption(name, caption):
     assert figure_caption(name) == caption
+
+
+def test_captions_of_a_build_keep_their_punctuation():
+    """Every pair name the bundled trains give comes back readable from its file name."""
+    from cadgen.report.plots.parts import pair_figure_jobs
+
+    class Stage:
+        def __init__(self, name):
+            self.name = name
+
+    class Train:
+        stages = [Stage("non-circular pair"), Stage("1:1 pair (D to E)"),
+                  Stage("train 1: idler 1 to idler 2")]
+
+    captions = [figure_caption(name) for name in pair_figure_jobs(Train())]
+    assert captions == ["Gear pair 1: non-circular pair", "Gear pair 2: 1:1 pair D to E",
+                        "Gear pair 3: train 1: idler 1 to idler 2"]
+
+
+@pytest.fixture(scope="module")
+def pricking_built():
+    from cadgen.pipeline.build import build
+
+    path = REFERENCE.parent / "kernel-b.toml"
+    return build(load_params(path), None, effects=["metrics"]).report
+
+
+def test_pricking_accuracy_section_shows_what_the_inverse_grid_buys(pricking_built):
+    report = pricking_built
+    rows_by_knob = {r["knob"]: r for r in report["accuracy_achieved"]}
+    check = report["verification"]
+    grid = rows_by_knob["resolution.inverse_grid"]
+    assert grid["value"] == check["inverse_grid"] == 720
+    assert f"within {check['forward_deviation_mm']:.1e} mm" in grid["achieved"]
+    assert check["forward_deviation_mm"] < 1e-2          # the forward check's tolerance
+    closure = float(re.search(r"close to ([0-9.e+-]+) rad", grid["achieved"])[1])
+    # the worst of the grid's and the two stages' closures, printed to two digits
+    assert float(f"{check['grid_closure_error_rad']:.1e}") <= closure < 1e-9
+    fits = rows_by_knob["Chebyshev fits (fixed rtol 1e-13)"]
+    tail = float(re.search(r"at most ([0-9.e+-]+) rad", fits["achieved"])[1])
+    assert 0 < tail < 1e-11 and re.fullmatch(r"\d+ pieces, degree 24", fits["value"])
+    curve = rows_by_knob["trajectory.degree"]
+    assert curve["value"] == 5
+    through = float(re.search(r"points within ([0-9.e+-]+) mm", curve["achieved"])[1])
+    assert through < 1e-9 and "its 12 type-value points" in curve["achieved"]
+
+    body = section(render_html(report, {}), "accuracy")
+    table = rows(body.split("<h3>Forward check")[0])
+    assert table[0] == ["knob", "value", "achieved", "basis"]
+    assert [row[0] for row in table[1:]] == [r["knob"] for r in report["accuracy_achieved"]]
+    shown = {row[0]: row for row in table[1:]}
+    assert shown["resolution.inverse_grid"][1] == "720"
+    assert shown["resolution.inverse_grid"][2] == grid["achieved"]
+    forward = {row[0]: row[1] for row in rows(body.split("<h3>Forward check")[1])}
+    assert forward["forward deviation"] == f"{check['forward_deviation_mm']:.2e} mm"
+    assert forward["inverse grid"] == "720"
+    assert "Accuracy achieved" in render_html(report, {})
+
+
+def test_highest_point_is_shown_as_a_height(planting):
+    search = planting["accuracy"]["minimum_searches"]["highest_point"]
+    height = planting["events"]["tip_height_mm"]["highest"]
+    # searched as the minimum of -y, reported as the height it is, with an upper bound
+    assert search["maximum"] and search["value"] == pytest.approx(height)
+    body = section(render_html(planting, {}), "accuracy")
+    (row,) = [r for r in rows(body) if r and r[0].startswith("highest point")]
+    assert float(row[1]) == pytest.approx(height, abs=1e-8) and float(row[1]) > 0
+    assert float(row[2]) >= float(row[1])                 # its bound is an upper one
+    assert not any(cell.startswith("-164") for cell in row)
+
+
+def test_clearances_are_labelled_by_method(planting):
+    report = copy.deepcopy(planting)
+    report["sweep"] = {"arm_interference": dict(sweep_entry(57.85, True, []),
+                                                label="arm distance (solids, FCL)",
+                                                carrier_angle_deg=82.8),
+                       "ground_clearance": dict(sweep_entry(119.377, True, []),
+                                                label="gearbox ground clearance (solids, FCL)",
+                                                carrier_angle_deg=0.17)}
+    metrics = {m["key"]: m for m in report["metrics"]}
+    estimates = {key: metrics[key]["value"] for key in ("arm_distance", "ground_clearance")}
+    for key in estimates:
+        metrics[key]["kinematic_estimate"] = estimates[key]
+    body = section(render_html(report, {}), "motion")
+    derived = body.split("<h3>Derived geometry</h3>")[1].split("<h3>Clearances by method")[0]
+    assert "arm distance at" not in derived and "ground clearance at" not in derived
+    table = rows(body.split("<h3>Clearances by method</h3>")[1])
+    assert table[0][1].startswith("kinematic estimate (centre lines C-E-P1-N and housing")
+    assert table[0][2] == "FCL on the solids (certified minimum), carrier angle"
+    by_name = {row[0]: row[1:] for row in table[1:]}
+    derived_values = planting["derived"]
+    assert by_name["arm distance"][0] == (
+        f"{estimates['arm_distance']:.3f} mm at {derived_values['arm_distance_at_deg']:.2f} deg")
+    assert by_name["arm distance"][1].startswith("57.850 mm at 82.80 deg")
+    assert by_name["ground clearance"][0].startswith(
+        f"{estimates['ground_clearance']:.3f} mm at "
+        f"{derived_values['ground_clearance_at_deg']:.2f} deg")
+    assert by_name["ground clearance"][1].startswith("119.377 mm at 0.17 deg")
+    # without the sweep, the solids' column says so
+    plain = rows(section(render_html(planting, {}), "motion")
+                 .split("<h3>Clearances by method</h3>")[1])
+    assert plain[1][2] == "not run in this build"
+
+
+def test_slow_windows_read_around_the_dead_centre():
+    report = copy.deepcopy(PRICKING)
+    report["field"]["per_inclination"][0]["slow_windows_deg"] = [[-77.88907, 51.91818]]
+    table = rows(section(render_html(report, {}), "field"))
+    assert table[0][5] == "slow windows (from R max)"
+    assert table[1][5] == "-77.9 to 51.9 deg" and table[2][5] == "32.5 to 85.0 deg"
 
 
 def _render_script():

@@ -188,6 +188,7 @@ def main_batch(args: argparse.Namespace) -> int:
     try:
         summaries = run_batch(jobs, args.output_dir, workers=args.workers,
                               scheduler=args.scheduler, on_result=progress.update,
+                              on_start=progress.started,
                               timeout=getattr(args, "timeout", None),
                               isolate=not getattr(args, "in_process", False))
     except (ImportError, OSError) as exc:  # no dask, or the scheduler cannot be reached

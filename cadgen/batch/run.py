@@ -17,11 +17,14 @@ from cadgen.batch.summary import _order
 __all__ = ["run_batch"]
 
 
-#: A local worker's state for Ctrl-C (see :func:`_worker_start`).
-_WORKER = {"pid": None, "busy": False, "interrupted": False}
+#: A local worker's state for Ctrl-C (see :func:`_worker_start`), and the queue on which it
+#: says which design it starts (read by the batch's process, see :func:`_run_local`).
+_WORKER = {"pid": None, "busy": False, "interrupted": False, "starts": None}
+#: Seconds between looks at the local workers' starts while waiting for results.
+_START_POLL_SECONDS = 0.1
 
 
-def _worker_start() -> None:
+def _worker_start(starts=None) -> None:
     """Initializer of a local worker: Ctrl-C stops its design, cleanly, without a traceback.
 
     The terminal sends SIGINT to the whole process group, the workers included. A busy
@@ -34,6 +37,7 @@ def _worker_start() -> None:
     import signal
 
     _WORKER["pid"] = os.getpid()
+    _WORKER["starts"] = starts
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
         signal.signal(signal.SIGINT, _worker_interrupt)
 
@@ -46,11 +50,13 @@ def _worker_interrupt(signum, frame) -> None:
         raise KeyboardInterrupt
 
 
-def _run_job(job, output_root, build, build_kwargs, timeout, isolate) -> dict:
-    """What a worker runs for one design."""
+def _run_job(job, output_root, build, build_kwargs, timeout, isolate, number=None) -> dict:
+    """What a worker runs for one design (the ``number``-th submitted, told on starting)."""
     if _WORKER["interrupted"]:
         raise KeyboardInterrupt(f"interrupted before {job.name} started")
     _WORKER["busy"] = True
+    if _WORKER["starts"] is not None and number is not None:
+        _WORKER["starts"].put((os.getpid(), number))   # SimpleQueue: at once, no feeder thread
     try:
         if isolate:
             return run_design_isolated(job, output_root, build, build_kwargs, timeout)
@@ -79,20 +85,55 @@ def _collect(futures: Mapping, finished: Iterable, on_result) -> list[dict]:
     return summaries
 
 
-def _run_local(jobs, output_root, task, workers, on_result):
+def _completed(futures, submitted, starts, on_start):
+    """``futures`` as they complete; meanwhile ``on_start(name)`` for each design a worker
+    starts (told on ``starts`` as ``(worker pid, number submitted)``).
+
+    In the order things happened: a design's start before its result, and the result of
+    the design a worker ran before the start of its next (a worker tells a start only
+    after returning its previous result, which may still be on its way here: it is waited
+    for, briefly, so the line never shows a worker running two designs).
+    """
+    from concurrent.futures import FIRST_COMPLETED, wait
+
+    pending, told = set(futures), set()
+    running = {}    # worker pid -> the future of the design it runs
+    while pending:
+        done, pending = wait(pending, timeout=_START_POLL_SECONDS, return_when=FIRST_COMPLETED)
+        while not starts.empty():
+            pid, number = starts.get()
+            previous = running.get(pid)
+            if previous is not None and previous not in told:
+                wait([previous])
+                pending.discard(previous)
+                done.discard(previous)
+                told.add(previous)
+                yield previous
+            running[pid] = submitted[number]
+            on_start(futures[submitted[number]].name)
+        for future in done:
+            told.add(future)
+            yield future
+
+
+def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     # spawn: one start method on every platform, safe when the parent holds threads (a
     # Dask client); each worker pays its imports once and forks each design from there.
     context = multiprocessing.get_context("spawn")
+    starts = context.SimpleQueue() if on_start is not None else None
     pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))), mp_context=context,
-                               initializer=_worker_start)
-    futures = {}
+                               initializer=_worker_start, initargs=(starts,))
+    futures, submitted = {}, []
     try:
-        for job in jobs:
-            futures[pool.submit(_run_job, job, output_root, *task)] = job
-        summaries = _collect(futures, as_completed(futures), on_result)
+        for number, job in enumerate(jobs):
+            submitted.append(pool.submit(_run_job, job, output_root, *task, number=number))
+            futures[submitted[-1]] = job
+        finished = (as_completed(futures) if starts is None
+                    else _completed(futures, submitted, starts, on_start))
+        summaries = _collect(futures, finished, on_result)
     except BaseException:
         # Cancelled here, not only through shutdown(cancel_futures=True): the pool's
         # manager thread cancels through a weak reference to the pool, which may be gone
@@ -129,7 +170,8 @@ def run_batch(jobs: Sequence[DesignJob], output_root: str | os.PathLike = "outpu
               workers: int | None = None, scheduler: str | None = None,
               build: Build | None = None, build_kwargs: Mapping | None = None,
               on_result: Callable[[dict], None] | None = None, timeout: float | None = None,
-              isolate: bool = True) -> list[dict]:
+              isolate: bool = True,
+              on_start: Callable[[str], None] | None = None) -> list[dict]:
     """Build every design, in local processes or on a Dask cluster.
 
     Parameters
@@ -152,6 +194,11 @@ def run_batch(jobs: Sequence[DesignJob], output_root: str | os.PathLike = "outpu
         Extra keyword arguments of the build.
     on_result : callable, optional
         Called with each summary as its design finishes (in finishing order).
+    on_start : callable, optional
+        Local processes: called with a design's name when a worker starts it (in this
+        process and thread, as on_result; a start is told before that design's result,
+        within 0.1 s of it). Not called on a Dask cluster, whose tasks do not say when
+        they start.
     timeout : float, optional
         Seconds each design may take (in its own process, start included): a design
         still running then is killed and reported with code ``timeout``.
@@ -197,6 +244,7 @@ def run_batch(jobs: Sequence[DesignJob], output_root: str | os.PathLike = "outpu
     if scheduler:
         summaries = _run_dask(jobs, root, task, scheduler, on_result)
     else:
-        summaries = _run_local(jobs, root, task, workers or os.cpu_count() or 1, on_result)
+        summaries = _run_local(jobs, root, task, workers or os.cpu_count() or 1, on_result,
+                               on_start)
     _clean_staging(root, {job.name for job in jobs})
     return sorted(summaries, key=_order)

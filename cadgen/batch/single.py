@@ -158,4 +158,19 @@ def run_design(job: DesignJob, output_root: str | os.PathLike, build: Build | No
     notes = [str(note) for note in report.get("failures", ()) or ()]
     return _summary(job, start, ok=True, passed=_flag(report.get("passed")),
                     metrics=_report_metrics(report), notes=notes, files=[str(f) for f in files],
+                    failure=_stage_failure(report),
                     output_dir=None if output_dir is None else str(output_dir))
+
+
+def _stage_failure(report: Mapping) -> dict | None:
+    """A built design whose stages did not all run (``"stage_failed"``), as a failure: the
+    stages and their problems (a teeth stage's ``fractional_teeth`` names the key to set)."""
+    failed = [r for r in report.get("stages", ()) if r.get("status", "ok") not in ("ok", "skipped")]
+    if not failed:
+        return None
+    problems = [dict(p) for r in failed for p in r.get("problems", ())]
+    return {"code": "stage_failed",
+            "message": "; ".join(f"stage {r['stage']} {r['status']}: {r.get('message', '')}"
+                                 for r in failed),
+            "exception": None, "problems": problems,
+            "stages": [r["stage"] for r in failed]}

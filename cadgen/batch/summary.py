@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import html
 import io
 import json
 import os
@@ -13,6 +12,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from cadgen.batch.html import summary_html
 from kinematics.errors import Problem
 
 __all__ = ["SUMMARY_CSV", "SUMMARY_HTML", "EXIT_OK", "EXIT_FAILED", "EXIT_PROBLEMS",
@@ -35,7 +35,11 @@ def _order(summary: Mapping) -> tuple:
 
 
 def _status(summary: Mapping) -> str:
-    return "ok" if summary["ok"] else "failed"
+    """``ok`` (built, every stage ran), ``stage_failed`` (built, but a stage failed: its
+    ``failure`` says which and why) or ``failed`` (not built)."""
+    if not summary["ok"]:
+        return "failed"
+    return "stage_failed" if summary.get("failure") else "ok"
 
 
 def _yes_no(value: bool | None) -> str:
@@ -63,7 +67,8 @@ def _failure_codes(summary: Mapping) -> str:
     failure = summary["failure"]
     if not failure:
         return ""
-    codes = [p["code"] for p in failure.get("problems") or ()] or [failure["code"]]
+    codes = ([failure["code"]] if failure["code"] == "stage_failed" else []) + \
+        [p["code"] for p in failure.get("problems") or ()] or [failure["code"]]
     return ";".join(dict.fromkeys(codes))
 
 
@@ -82,7 +87,8 @@ def _why_not(summary: Mapping) -> str:
 def summary_csv(summaries: Sequence[Mapping]) -> str:
     """The batch summary as CSV text: one row per design, ordered by name.
 
-    Columns: ``design``, ``status`` (ok/failed), ``passed`` (yes/no, empty without
+    Columns: ``design``, ``status`` (ok, ``stage_failed``: built but a stage failed, or
+    failed), ``passed`` (yes/no, empty without
     targets), ``missed_targets``, one ``grid:<key>`` column per grid key, one column per
     metric id (its value), ``notes`` (why a built design did not pass, when its report
     says), ``failure_code`` (its problems' codes; ``exception`` for an error in the
@@ -111,68 +117,21 @@ def summary_csv(summaries: Sequence[Mapping]) -> str:
     return stream.getvalue()
 
 
-_HTML_STYLE = """
-body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; }
-table { border-collapse: collapse; font-size: 0.9em; } th { background: #f3f3f3; }
-th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; vertical-align: top; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; } .ok { color: #176117; }
-.failed, .miss { color: #a40000; font-weight: bold; } td.reason { white-space: pre-wrap; }
-"""
+def write_summary(summaries: Sequence[dict], output_root: str | os.PathLike, *,
+                  title: str = "Batch summary") -> tuple[Path, Path]:
+    """Write ``batch-summary.csv`` and ``.html`` atomically under ``output_root``; their paths.
 
-
-def summary_html(summaries: Sequence[Mapping], title: str = "Batch summary") -> str:
-    """The batch summary as one self-contained HTML page (a table, inline style).
-
-    Same rows and order as :func:`summary_csv`; metric headers carry their units, a
-    missed target is marked, and a failed design shows every problem.
+    The page links each built design's ``report.html`` relative to ``output_root`` and,
+    for a grid (each summary's ``values``), plots every metric against every varied key
+    (see :func:`~cadgen.batch.html.summary_html`); ``title`` heads it.
     """
-    esc = html.escape
-    ordered = sorted(summaries, key=_order)
-    grid_keys, metric_ids = _columns(ordered)
-    units = {k: m.get("unit") or "" for s in reversed(ordered) for k, m in s["metrics"].items()}
-    built = sum(s["ok"] for s in ordered)
-    not_passed = sum(s["ok"] and s["passed"] is False for s in ordered)
-    head = ["design", "status", "passed", *grid_keys,
-            *(f"{k} ({units[k]})" if units[k] else k for k in metric_ids), "failure or notes",
-            "source"]
-    rows = []
-    for s in ordered:
-        cells = [f"<td>{esc(s['name'])}</td>",
-                 f"<td class=\"{_status(s)}\">{_status(s)}</td>",
-                 f"<td class=\"{'miss' if s['passed'] is False else ''}\">"
-                 f"{_yes_no(s['passed'])}</td>"]
-        cells += [f"<td class=\"num\">{esc(_cell(s.get('values', {}).get(k)))}</td>"
-                  for k in grid_keys]
-        for k in metric_ids:
-            m = s["metrics"].get(k) or {"value": None}
-            target = f" title=\"target {esc(str(m['target']))}\"" if m.get("target") else ""
-            mark = " miss" if m.get("passed") is False else ""
-            value = "" if m["value"] is None else f"{m['value']:.6g}"
-            cells.append(f"<td class=\"num{mark}\"{target}>{value}</td>")
-        failure = s["failure"]
-        reason = ("\n".join(s.get("notes", ())) if not failure else
-                  "\n".join(str(Problem(**p)) for p in failure["problems"]) if failure["problems"]
-                  else f"{failure['message']} [{failure['code']}]")
-        cells += [f"<td class=\"reason\">{esc(reason)}</td>", f"<td>{esc(s['source'])}</td>"]
-        rows.append("<tr>" + "".join(cells) + "</tr>")
-    return (
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-        f"<title>{esc(title)}</title>\n<style>{_HTML_STYLE}</style>\n</head>\n<body>\n"
-        f"<h1>{esc(title)}</h1>\n<p>{len(ordered)} designs: {built} built, "
-        f"{len(ordered) - built} failed, {not_passed} built but did not pass.</p>\n"
-        "<table>\n<thead><tr>" + "".join(f"<th>{esc(h)}</th>" for h in head) + "</tr></thead>\n"
-        "<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>\n</body>\n</html>\n"
-    )
-
-
-def write_summary(summaries: Sequence[dict], output_root: str | os.PathLike) -> tuple[Path, Path]:
-    """Write ``batch-summary.csv`` and ``.html`` atomically under ``output_root``; their paths."""
     from cadgen.export.atomic import write_text_atomic
 
     root = Path(output_root)
     root.mkdir(parents=True, exist_ok=True)
     return (write_text_atomic(root / SUMMARY_CSV, summary_csv(summaries)),
-            write_text_atomic(root / SUMMARY_HTML, summary_html(summaries)))
+            write_text_atomic(root / SUMMARY_HTML,
+                              summary_html(summaries, title, root=root)))
 
 
 def batch_exit_code(summaries: Iterable[Mapping], strict: bool = False) -> int:
@@ -204,10 +163,13 @@ def _reason(summary: Mapping) -> str:
 
 
 class Progress:
-    """A one-line progress bar: ``[12/40] 30% ok 11, failed 1, eta 00:42``.
+    """A one-line progress bar: ``[12/40] 30% ok 11, failed 1, 2 running (r-011, -012),
+    26 queued, eta 00:42``.
 
     On a terminal the line is redrawn in place (failures printed above it); elsewhere (a
-    log, CI) it prints one line per finished design.
+    log, CI) it prints one line per change: a design started, a design finished. Designs
+    are ``running`` from :meth:`started` (a worker took them) to :meth:`update`; without
+    starts (a Dask cluster does not tell them) the line has no running or queued part.
 
     Parameters
     ----------
@@ -223,25 +185,60 @@ class Progress:
         self.stream = sys.stderr if stream is None else stream
         self.tty = bool(tty if tty is not None else getattr(self.stream, "isatty", bool)())
         self.done = self.ok = self.failed = 0
+        self.running: list[str] = []        # in the order they started
+        self._early: list[str] = []         # finished before their start was told
+        self._starts = False
         self.start = time.perf_counter()
         if self.tty:  # show the bar at once: the first design may take a while
             self.stream.write(self.line())
             self.stream.flush()
 
+    @property
+    def queued(self) -> int:
+        """Designs neither started nor finished (meaningful once a start was told)."""
+        return max(0, self.total - self.done - len(self.running))
+
     def line(self) -> str:
         """The current progress line (no line break)."""
         percent = 100 * self.done // self.total if self.total else 100
         text = f"[{self.done}/{self.total}] {percent}% ok {self.ok}, failed {self.failed}"
+        if self._starts:
+            text += f", {self._activity()}"
         if 0 < self.done < self.total:
             elapsed = time.perf_counter() - self.start
             text += f", eta {_clock(elapsed / self.done * (self.total - self.done))}"
         return text
+
+    def _activity(self) -> str:
+        """``2 running (l2-sweep-004, -005), 4 queued``."""
+        text = f"{len(self.running)} running"
+        if self.running:
+            text += f" ({_names(self.running)})"
+        return text + f", {self.queued} queued"
+
+    def started(self, name: str) -> None:
+        """A worker started design ``name``: show it running."""
+        self._starts = True
+        if name in self._early:          # its result came first: it is done already
+            self._early.remove(name)
+            return
+        self.running.append(name)
+        if self.tty:
+            self.stream.write("\r\x1b[K" + self.line())
+        else:
+            self.stream.write(f"[{self.done}/{self.total}] started {name}; "
+                              f"{self._activity()}\n")
+        self.stream.flush()
 
     def update(self, summary: Mapping) -> None:
         """Count one finished design and show it."""
         self.done += 1
         self.ok += bool(summary["ok"])
         self.failed += not summary["ok"]
+        if summary["name"] in self.running:
+            self.running.remove(summary["name"])
+        elif self._starts:
+            self._early.append(summary["name"])
         if self.tty:
             if not summary["ok"]:
                 self.stream.write(f"\r\x1b[Kfailed {summary['name']}: {_reason(summary)}\n")
@@ -249,7 +246,8 @@ class Progress:
         else:
             verdict = "ok" if summary["ok"] else f"failed: {_reason(summary)}"
             self.stream.write(f"[{self.done}/{self.total}] {summary['name']} {verdict} "
-                              f"({summary['seconds']:.1f} s)\n")
+                              f"({summary['seconds']:.1f} s)"
+                              + (f"; {self._activity()}" if self._starts else "") + "\n")
         self.stream.flush()
 
     def close(self) -> None:
@@ -257,3 +255,20 @@ class Progress:
         if self.tty and self.done:
             self.stream.write("\n")
             self.stream.flush()
+
+
+#: Running designs named on the progress line; more are counted.
+_NAMES_SHOWN = 4
+
+
+def _names(names: Sequence[str], shown: int = _NAMES_SHOWN) -> str:
+    """``l2-sweep-004, -005``: a name after the first that shares its stem up to the last
+    hyphen is shortened to its suffix; past ``shown`` names, ``+N more``."""
+    first = names[0]
+    stem = first[:first.rfind("-")] if "-" in first else None
+    out = [first]
+    for name in names[1:shown]:
+        out.append(name[len(stem):] if stem and name.startswith(stem + "-") else name)
+    if len(names) > shown:
+        out.append(f"+{len(names) - shown} more")
+    return ", ".join(out)

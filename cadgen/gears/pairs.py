@@ -26,7 +26,8 @@ from cadgen.gears.teeth import GearProfile
 from cadgen.gears.teeth import CutterChoice, ToothSystem, gear_outline
 
 __all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "generate_gear",
-           "mating_phase", "circle_pair", "MIN_SHAPER_TEETH"]
+           "mating_phase", "circle_pair", "MIN_SHAPER_TEETH", "MIN_ROOT_THICKNESS",
+           "FAILING_PROBLEMS"]
 
 #: The smallest pinion cutter considered (fewer teeth would undercut itself).
 MIN_SHAPER_TEETH = 10
@@ -34,6 +35,18 @@ MIN_SHAPER_TEETH = 10
 SHAPER_CLEARANCE = 0.9
 #: A tooth whose tip is thinner than this many modules is pointed.
 MIN_TIP_THICKNESS = 0.25
+#: The undercut policy (both mechanisms): an undercut tooth is a warning while its remaining
+#: root thickness (its narrowest section between the pitch curve and the root fillet, measured
+#: on the cut outline) is at least this many modules, and a failure below it. A full tooth is
+#: pi/2 = 1.571 m thick there (at the pitch curve); by Lewis' bending section (root stress
+#: 6 F h / (b s^2)) a tooth of 1.25 m keeps (1.25 / 1.571)^2 = 63 % of the full tooth's
+#: section modulus, the bending stress rising at most 1.58 times: about what a standard 20-deg
+#: spur gear loses from 17 teeth to 10 (Lewis form factors 0.303 and about 0.20), the fewest
+#: teeth the usual Lewis tables list. Measured here, a circular gear cut by the standard rack
+#: meets it with 8 teeth (1.30 m) and not with 7 (1.20 m).
+MIN_ROOT_THICKNESS = 1.25
+#: Gear-check problems that fail the design; every other one is a warning.
+FAILING_PROBLEMS = frozenset({"undercut_root_too_thin"})
 
 
 @dataclass(frozen=True)
@@ -109,6 +122,13 @@ class GearCheck:
     tip_thickness_min: float
     pressure_angle_deviation_max_deg: float
     problems: list = field(default_factory=list)
+    undercut_root_thickness_min: float | None = None   # of the undercut teeth (None: none)
+    root_thickness_limit: float = 0.0                   # MIN_ROOT_THICKNESS modules, mm
+
+    @property
+    def failing(self) -> list:
+        """The problems that fail the design (:data:`FAILING_PROBLEMS`): (code, message)."""
+        return [(code, message) for code, message in self.problems if code in FAILING_PROBLEMS]
 
 
 @dataclass(frozen=True)
@@ -212,10 +232,23 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
     deviation = float(np.degrees(np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", radial, outward)),
                                                    0, 1))).max())
     problems += _check_problems(name, concave, concave_min, shaper_teeth, system)
+    limit = MIN_ROOT_THICKNESS * system.module
+    undercut_root = float(root[undercut].min()) if undercut else None
     if undercut:
-        problems.append(("undercut", f"the {name} gear's teeth {_list(undercut)} are undercut; "
-                         f"remaining root thickness down to {root[undercut].min():.3f} mm: use a "
-                         "smaller module (more teeth), a profile shift, or a shaper cutter"))
+        thin = [k for k in undercut if root[k] < limit]
+        measured = (f"remaining root thickness down to {undercut_root:.3f} mm "
+                    f"({undercut_root / system.module:.3f} m)")
+        if thin:
+            problems.append(("undercut_root_too_thin",
+                             f"the {name} gear's teeth {_list(thin)} are undercut below the "
+                             f"root-thickness limit: {measured}, under {limit:.3f} mm "
+                             f"({MIN_ROOT_THICKNESS:g} m); use a smaller module (more teeth), a "
+                             "profile shift, or a shaper cutter"))
+        else:
+            problems.append(("undercut", f"the {name} gear's teeth {_list(undercut)} are "
+                             f"undercut; {measured}, at least the {limit:.3f} mm "
+                             f"({MIN_ROOT_THICKNESS:g} m) limit, so a warning: a smaller module "
+                             "(more teeth), a profile shift or a shaper cutter would avoid it"))
     if pointed:
         problems.append(("pointed_teeth", f"the {name} gear's teeth {_list(pointed)} are pointed "
                          f"(tip thickness down to {tip.min():.3f} mm, below "
@@ -227,7 +260,7 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
         cutter=" and ".join(sorted(kinds)), shaper_teeth=shaper_teeth if "shaper" in kinds else None,
         undercut_teeth=undercut, root_thickness_min=float(root.min()), pointed_teeth=pointed,
         tip_thickness_min=float(tip.min()), pressure_angle_deviation_max_deg=deviation,
-        problems=problems)
+        problems=problems, undercut_root_thickness_min=undercut_root, root_thickness_limit=limit)
 
 
 def _simple(geometry) -> bool:

@@ -17,7 +17,8 @@ import numpy as np
 
 from kinematics.errors import DesignError
 
-from cadgen.gears.pairs import PitchPair, circle_pair, generate_pair
+from cadgen.gears.pairs import (FAILING_PROBLEMS, MIN_ROOT_THICKNESS, PitchPair, circle_pair,
+                                generate_pair)
 from cadgen.gears.meshing import meshing_check, relieve_interference
 from cadgen.gears.teeth import ToothSystem
 
@@ -28,30 +29,84 @@ __all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "prickin
 MIN_CIRCULAR_TEETH = 17
 
 
-def circular_module(radii, requested=None) -> float:
+def _whole(radii, module, min_teeth=0) -> bool:
+    counts = [2 * r / module for r in radii]
+    return all(abs(c - round(c)) < 1e-6 and round(c) >= min_teeth for c in counts)
+
+
+def _auto_module(radii) -> float | None:
+    """The largest 0.05-mm step from 5 mm down to 0.5 mm giving every circular gear a whole
+    count of at least ``MIN_CIRCULAR_TEETH`` teeth, or None."""
+    for step in range(100, 9, -1):
+        if _whole(radii, step * 0.05, MIN_CIRCULAR_TEETH):
+            return round(step * 0.05, 10)
+    return None
+
+
+def _finest_module(radii, below: float = 5.0) -> float | None:
+    """The largest 0.01-mm step below ``below`` giving whole tooth counts (any count), or None."""
+    for step in range(int(round(below * 100)), 0, -1):
+        if _whole(radii, step * 0.01):
+            return round(step * 0.01, 10)
+    return None
+
+
+def _teeth_text(radii, module) -> str:
+    return ", ".join(str(int(round(2 * r / module))) for r in radii)
+
+
+def circular_module(radii, requested=None, *, hint: str = "") -> float:
     """The requested module, or the largest 0.05-mm step (5 mm down) giving whole tooth counts.
 
     Only modules that give every circular gear at least ``MIN_CIRCULAR_TEETH``
-    teeth are considered, so no circular gear is undercut.
+    teeth are considered, so no circular gear is undercut. When none fits, the
+    ``fractional_teeth`` problem names the key to set (``gears.circular_module``) and a
+    value that works; ``hint`` (another key and value that would, e.g. ``train.R``) is
+    added to it.
     """
+    diameters = ", ".join(f"{2 * r:g}" for r in radii)
     if requested is not None:
-        counts = [2 * r / requested for r in radii]
-        if not all(abs(c - round(c)) < 1e-6 for c in counts):
+        if not _whole(radii, requested):
+            counts = [2 * r / requested for r in radii]
+            auto = _auto_module(radii)
+            finest = _finest_module(radii, requested)
+            works = ([f"set gears.circular_module = {auto:g} (teeth {_teeth_text(radii, auto)})"
+                      f" or leave it out to have {auto:g} mm chosen"] if auto else
+                     [f"set gears.circular_module = {finest:g} (teeth "
+                      f"{_teeth_text(radii, finest)})"] if finest else [])
             raise DesignError.single(
                 "gears.circular_module", "fractional_teeth",
                 f"module {requested:g} mm gives tooth counts {', '.join(f'{c:.3f}' for c in counts)}"
                 f" for the circular gears of radii {', '.join(f'{r:g}' for r in radii)} mm: "
-                "choose a module that divides every pitch diameter")
+                f"choose a module that divides every pitch diameter ({diameters} mm)"
+                + "".join(f": {w}" for w in works) + (f"; or {hint}" if hint else ""))
         return float(requested)
-    for step in range(100, 9, -1):
-        module = step * 0.05
-        counts = [2 * r / module for r in radii]
-        if all(abs(c - round(c)) < 1e-6 and round(c) >= MIN_CIRCULAR_TEETH for c in counts):
-            return round(module, 10)
-    raise DesignError.single("gears.circular_module", "fractional_teeth",
-                             f"no module from 0.5 to 5 mm gives whole tooth counts for the circular "
-                             f"gears of radii {', '.join(f'{r:g}' for r in radii)} mm; set one")
+    module = _auto_module(radii)
+    if module is not None:
+        return module
+    finest = _finest_module(radii)
+    works = (f"; set gears.circular_module to a module that divides every pitch diameter "
+             f"({diameters} mm), e.g. {finest:g} (teeth {_teeth_text(radii, finest)})"
+             if finest else "")
+    raise DesignError.single(
+        "gears.circular_module", "fractional_teeth",
+        f"no module from 0.5 to 5 mm (0.05-mm steps, at least {MIN_CIRCULAR_TEETH} teeth) gives "
+        f"whole tooth counts for the circular gears of radii "
+        f"{', '.join(f'{r:g}' for r in radii)} mm{works}" + (f"; or {hint}" if hint else ""))
 
+
+def _radius_hint(mechanism) -> str:
+    """The nearest base radii ``train.R`` (0.5-mm steps) whose circular gears take an
+    automatic module, as a hint for ``fractional_teeth``."""
+    found = []
+    for sign in (-1, 1):
+        for k in range(1, 41):
+            R = mechanism.R + sign * 0.5 * k
+            radii = [R, R * mechanism.i12, R * mechanism.i13, R, mechanism.r]
+            if R > 0 and _auto_module(radii) is not None:
+                found.append(f"train.R = {R:g} (module {_auto_module(radii):g} mm)")
+                break
+    return "set " + " or ".join(found) if found else ""
 
 
 def planting_circular_radii(mechanism) -> list:
@@ -159,8 +214,23 @@ def planting_pair(mechanism) -> PitchPair:
     return PitchPair(("central", "intermediate"), a, 2 * np.pi, central, intermediate)
 
 
-def planting_train(params, mechanism) -> GearTrain:
-    """The planting mechanism's gears at the catching position (phi = 0)."""
+def _report_to(progress, total):
+    """``progress(done, total, pair name)`` after each pair, or nothing (``progress=None``)."""
+    done = [0]
+
+    def cut(name):
+        done[0] += 1
+        if progress is not None:
+            progress(done[0], total, name)
+    return cut
+
+
+def planting_train(params, mechanism, progress=None) -> GearTrain:
+    """The planting mechanism's gears at the catching position (phi = 0).
+
+    ``progress(done, total, pair name)``, optional, is called as each of the five pairs is cut.
+    """
+    cut = _report_to(progress, 5)
     cutting = params.gears
     a = mechanism.centre_distance
     teeth = params.pitch_curve.teeth
@@ -170,31 +240,44 @@ def planting_train(params, mechanism) -> GearTrain:
     module_nc = mechanism.module(teeth)   # the spec: module from perimeter and z
     stages = [_stage("non-circular pair", pair, teeth, _system(cutting, module_nc), cutting,
                      (box, C))]
+    cut(stages[-1].name)
     # circular gears: gearbox 2's 1:1 pair and train 1's set with converted ratio -1
     radii = planting_circular_radii(mechanism)
-    module = circular_module(radii, cutting.circular_module)
+    try:
+        module = circular_module(radii, cutting.circular_module)
+    except DesignError:   # again, naming the base radii that would work too
+        module = circular_module(radii, cutting.circular_module, hint=_radius_hint(mechanism))
     system = _system(cutting, module)
     z = [int(round(2 * x / module)) for x in radii]
     D = C + a * np.array([math.cos(box), math.sin(box)])
     stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), mechanism.r, mechanism.r),
                          (z[4], z[4]), system, cutting, (box, D), circular=True))
+    cut(stages[-1].name)
     carrier = mechanism.phi0
     line = np.array([math.cos(carrier), math.sin(carrier)])
     first = _stage("train 1: sun to idler 1", circle_pair(("sun", "idler 1"), radii[0], radii[1]),
                    (z[0], z[1]), system, cutting, (carrier, np.zeros(2)), circular=True)
+    cut(first.name)
     second = _stage("train 1: idler 1 to idler 2",
                     circle_pair(("idler 1", "idler 2"), radii[1], radii[2]), (z[1], z[2]), system,
                     cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated),
                     circular=True)
+    cut(second.name)
     third = _stage("train 1: idler 2 to planet",
                    circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3]), (z[2], z[3]),
                    system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
                    drive=_carry(second.generated), circular=True)
+    cut(third.name)
     return GearTrain(tuple(stages + [first, second, third]))
 
 
-def pricking_train(params, design) -> GearTrain:
-    """The pricking mechanism's two non-circular stages at the outer dead centre."""
+def pricking_train(params, design, progress=None) -> GearTrain:
+    """The pricking mechanism's two non-circular stages at the outer dead centre.
+
+    ``progress(done, total, stage name)``, optional, is called as each stage is cut (or found
+    not cuttable).
+    """
+    cut = _report_to(progress, 2)
     cutting = params.gears
     motion, link = design.motion, design.linkage
     functions, breaks = design.cycle_functions()
@@ -213,6 +296,7 @@ def pricking_train(params, design) -> GearTrain:
                                  (carrier, centre + index * link.a * line)))
         except DesignError as error:  # reported with the gear and the reason; others go on
             failures += [(f"stage {index + 1}", problem) for problem in error.problems]
+        cut(f"stage {index + 1}")
     return GearTrain(tuple(stages), tuple(failures))
 
 
@@ -244,7 +328,11 @@ def train_report(train: GearTrain) -> dict:
             "undercut_teeth": check.undercut_teeth, "root_thickness_min_mm": check.root_thickness_min,
             "pointed_teeth": check.pointed_teeth, "tip_thickness_min_mm": check.tip_thickness_min,
             "pressure_angle_deviation_max_deg": check.pressure_angle_deviation_max_deg,
-            "problems": [{"code": c, "message": m} for c, m in check.problems],
+            "undercut_root_thickness_min_mm": check.undercut_root_thickness_min,
+            "root_thickness_limit_mm": check.root_thickness_limit,
+            "problems": [{"code": c, "message": m,
+                          "severity": "failure" if c in FAILING_PROBLEMS else "warning"}
+                         for c, m in check.problems],
             "outline_points": int(len(profile.outline)),
         })
     meshes = [{
@@ -262,4 +350,14 @@ def train_report(train: GearTrain) -> dict:
     } for s in train.stages]
     failures = [{"stage": stage, "path": p.path, "code": p.code, "message": p.message}
                 for stage, p in train.failures]
-    return {"gears": gears, "meshes": meshes, "failures": failures}
+    return {"gears": gears, "meshes": meshes, "failures": failures,
+            "root_thickness_policy": ROOT_THICKNESS_POLICY}
+
+
+#: The undercut policy in words, for the report (the threshold is ``MIN_ROOT_THICKNESS``).
+ROOT_THICKNESS_POLICY = (
+    f"an undercut tooth is a warning while its remaining root thickness is at least "
+    f"{MIN_ROOT_THICKNESS:g} modules (80 % of the full tooth's pi m / 2, 63 % of its bending "
+    "section by Lewis), a failure below it; the kinematic undercut finding (radius of "
+    "curvature below m ha* / sin^2 alpha) is a prediction for rack cutting, and the cut "
+    "teeth's measured root thickness decides")

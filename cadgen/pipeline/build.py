@@ -44,6 +44,8 @@ import numpy as np
 
 from kinematics.errors import ConvergenceError, DesignError, MechanismError
 
+from cadgen.pipeline.progress import WRITE_STAGE
+
 __all__ = ["EFFECT_STAGES", "plan", "stage_warnings", "BuildResult", "build", "EXIT_OK",
            "EXIT_CHECKS_FAILED", "run_analysis", "AnalysisResult"]
 
@@ -151,15 +153,20 @@ class BuildResult:
         for warning in self.report.get("warnings", []):
             text += (f"\nwarning: {warning['path'] or '<file>'}: {warning['message']} "
                      f"[{warning['code']}] (stage {warning['stage']}, not run in this build)")
-        return text + (f"\nwrote {len(self.files)} files to {self.output_dir}"
+        count = len(self.files)
+        return text + (f"\nwrote {count} file{'s' * (count != 1)} to {self.output_dir}"
                        if self.output_dir else "")
 
 
 class _Build:
     """One build's state: the values each stage made, its records, figures and writers."""
 
-    def __init__(self, params, stages, steps):
+    def __init__(self, params, stages, steps, progress=None):
+        from cadgen.pipeline.progress import StageProgress
+
         self.params = params
+        self.progress = progress if isinstance(progress, StageProgress) \
+            else StageProgress(progress)
         self.stages = stages
         self.steps = steps
         self.values: dict = {}
@@ -178,17 +185,25 @@ class _Build:
                 ahead = _start_sweeps_ahead(self, functions)
             failed = [need for need in STAGE_NEEDS[stage]
                       if need in self.stages and self.status(need) != "ok"]
+            if ahead is not None and stage in SWEEP_STAGES:
+                outcomes = ahead.result()
+                self.progress.join()    # the worker's events, all delivered
             if failed:
-                self.records.append(StageRecord(stage, "skipped", message=(
-                    f"needs {', '.join(failed)}, which did not complete")))
+                record = StageRecord(stage, "skipped", message=(
+                    f"needs {', '.join(failed)}, which did not complete"))
+                self.records.append(record)
+                self.progress.finished(stage, "skipped", 0.0, detail=record.message)
                 continue
             if ahead is not None and stage in SWEEP_STAGES:
-                record, value = ahead.result()[stage]
-                self.records.append(record)
-                if record.status == "ok":
-                    self.values[stage] = value
-                continue
-            record, value = _run_stage(self, stage, functions)
+                record, value = outcomes[stage]
+                if stage not in self.progress.finished_stages():   # the worker said nothing
+                    self.progress.finished(stage, record.status, record.seconds,
+                                           detail=record.message, beside=True)
+            else:
+                self.progress.started(stage)
+                record, value = _run_stage(self, stage, functions)
+                self.progress.finished(stage, record.status, record.seconds,
+                                       detail=record.message)
             self.records.append(record)
             if record.status == "ok":
                 self.values[stage] = value
@@ -228,29 +243,52 @@ def _start_sweeps_ahead(run, functions):
         return None
     from concurrent.futures import ProcessPoolExecutor
 
-    _AHEAD.update(run=run, functions=functions, sweeps=sweeps)
+    ends = run.progress.pipe()
+    _AHEAD.update(run=run, functions=functions, sweeps=sweeps,
+                  events=ends[1] if ends else None)
     pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
-    future = pool.submit(_sweeps_ahead)
+    try:
+        future = pool.submit(_sweeps_ahead)   # forks the worker here
+    finally:
+        _AHEAD.clear()              # the forked worker has its own copy
+        if ends:
+            run.progress.relay(ends[0])
+            ends[1].close()         # the worker's copy is the last: its end is the relay's
     pool.shutdown(wait=False)   # the worker ends after its one task
-    _AHEAD.clear()              # the forked worker has its own copy
     return future
 
 
 def _sweeps_ahead() -> dict:
     """In the forked worker: the gearless parts, then each sweep; ``{stage: (record, value)}``."""
     run, functions, sweeps = _AHEAD["run"], _AHEAD["functions"], _AHEAD["sweeps"]
-    parts_record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
-    out = {}
-    for stage in sweeps:
-        if parts_record.status != "ok":
-            out[stage] = (StageRecord(stage, "skipped", message="needs parts, which did not "
-                                                                "complete"), None)
-            continue
-        run.values["parts"] = parts
-        record, value = _run_stage(run, stage, functions)
-        record.message = record.message or "ran beside the teeth, in a second process"
-        out[stage] = (record, value)
-    return out
+    events, progress = _AHEAD.get("events"), run.progress
+    if events is not None:
+        progress.forward(events)
+    try:
+        progress.started("parts", detail="without gears, for the sweeps", beside=True)
+        parts_record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
+        progress.finished("parts", parts_record.status, parts_record.seconds,
+                          detail=parts_record.message or "without gears, for the sweeps",
+                          beside=True)
+        out = {}
+        for stage in sweeps:
+            if parts_record.status != "ok":
+                record = StageRecord(stage, "skipped",
+                                     message="needs parts, which did not complete")
+                progress.finished(stage, "skipped", 0.0, detail=record.message, beside=True)
+                out[stage] = (record, None)
+                continue
+            run.values["parts"] = parts
+            progress.started(stage, beside=True)
+            record, value = _run_stage(run, stage, functions)
+            record.message = record.message or "ran beside the teeth, in a second process"
+            progress.finished(stage, record.status, record.seconds, detail=record.message,
+                              beside=True)
+            out[stage] = (record, value)
+        return out
+    finally:
+        if events is not None:
+            events.close()          # the relay's end of file
 
 
 # --------------------------------------------------------------------------- stages
@@ -281,9 +319,11 @@ def _metrics(run):
 def _teeth(run):
     from cadgen.gears.trains import planting_train, pricking_train
 
-    if run.params.mechanism == "pricking":
-        return pricking_train(run.params, run.values["kinematics"])
-    return planting_train(run.params, run.values["kinematics"])
+    def cut(done, total, pair):
+        run.progress.step("teeth", pair, steps=total)
+
+    train = pricking_train if run.params.mechanism == "pricking" else planting_train
+    return train(run.params, run.values["kinematics"], progress=cut)
 
 
 def _cam(run):
@@ -360,7 +400,7 @@ def stage_warnings(params, stages) -> list:
 
 def build(params, output_root: Path | str | None = Path("outputs"), *, effects=None,
           case: str | None = None, steps: int | None = None,
-          preset: str | None = None) -> BuildResult:
+          preset: str | None = None, progress=None) -> BuildResult:
     """Build one validated design: the stages its effects need, then its outputs.
 
     Parameters
@@ -378,6 +418,12 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     preset : {"draft", "standard", "fine"}, optional
         Overrides the file's ``scene.preset``: the resolution of every knob the file
         leaves out (see :mod:`cadgen.params.scene`).
+    progress : callable, optional
+        Called with a :class:`~cadgen.pipeline.progress.ProgressEvent` as each stage
+        starts, steps on (teeth: per gear pair; plots: per figure; writing: per group of
+        files) and finishes, and for the pseudo-stage ``"write"`` (the output folder).
+        In this process, never twice at once; the sweeps run beside the teeth, so their
+        events interleave with the teeth's (``event.beside``). Nothing is printed.
 
     Raises
     ------
@@ -402,7 +448,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     case = case or scene.case
     stages, set_aside = plan(effects, params.mechanism, case)
     warnings = stage_warnings(params, stages)
-    run = _Build(params, stages, steps)
+    run = _Build(params, stages, steps, progress)
     run.warnings = warnings
     run.effects, run.case = effects, case
     run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
@@ -423,25 +469,53 @@ def _write(run, final: Path) -> BuildResult:
 
     report = run.report
     files = []
-    with staged_directory(final) as staging:
-        for writer in writers_for(run):
-            files += [str(path) for path in writer(staging)]
-        if run.figures:
-            (staging / "plots").mkdir(exist_ok=True)
-            for name, data in run.figures.items():
-                (staging / "plots" / name).write_bytes(data)
-                files.append(f"plots/{name}")
-        files.append("report.json")
-        if "report" in run.effects:
-            from cadgen.report.html import render_html
+    writers = writers_for(run)
+    progress = run.progress
+    progress.started(WRITE_STAGE, steps=len(writers) + bool(run.figures) + 1
+                     + ("report" in run.effects), detail=str(final))
+    start = time.perf_counter()
+    try:
+        with staged_directory(final) as staging:
+            for writer in writers:
+                written = [str(path) for path in writer(staging)]
+                files += written
+                progress.step(WRITE_STAGE, _group(written))
+            if run.figures:
+                (staging / "plots").mkdir(exist_ok=True)
+                for name, data in run.figures.items():
+                    (staging / "plots" / name).write_bytes(data)
+                    files.append(f"plots/{name}")
+                progress.step(WRITE_STAGE, _group([f"plots/{n}" for n in run.figures]))
+            files.append("report.json")
+            if "report" in run.effects:
+                from cadgen.report.animation import animation_data
+                from cadgen.report.html import render_html
 
-            (staging / "report.html").write_text(render_html(report, run.figures),
-                                                 encoding="utf-8")
-            files.append("report.html")
-        report["files"] = sorted(files)
-        (staging / "report.json").write_text(
-            json.dumps(report, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+                glb = staging / "solids" / "assembly.glb"   # the 3D view shows the file written
+                (staging / "report.html").write_text(render_html(
+                    report, run.figures, animation=animation_data(run.params, run.values),
+                    assembly_glb=glb.read_bytes() if glb.is_file() else None), encoding="utf-8")
+                files.append("report.html")
+                progress.step(WRITE_STAGE, "report.html")
+            report["files"] = sorted(files)
+            (staging / "report.json").write_text(
+                json.dumps(report, indent=2, default=_jsonable) + "\n", encoding="utf-8")
+            progress.step(WRITE_STAGE, "report.json")
+    except Exception as error:
+        progress.finished(WRITE_STAGE, "failed", time.perf_counter() - start,
+                          detail=f"{type(error).__name__}: {error}")
+        raise
+    progress.finished(WRITE_STAGE, "ok", time.perf_counter() - start,
+                      detail=f"{len(files)} file{'s' * (len(files) != 1)} in {final}")
     return BuildResult(run.params.name, report, final, sorted(files))
+
+
+def _group(paths) -> str:
+    """A step's files in a few words: ``gears/ (7 files)``, ``cam.dxf``."""
+    if len(paths) == 1:
+        return paths[0]
+    folders = sorted({p.split("/")[0] + "/" if "/" in p else p for p in paths})
+    return f"{', '.join(folders)} ({len(paths)} file{'s' * (len(paths) != 1)})"
 
 
 def _jsonable(value):

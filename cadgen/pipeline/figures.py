@@ -48,19 +48,31 @@ def figure_jobs(run) -> dict:
     if sweeps:
         from cadgen.report.plots.parts import clearance_figure
 
-        jobs["clearance.png"] = lambda: clearance_figure(sweeps)
+        # the pricking assembly turns from the outer (R max) dead centre, the planting one
+        # from the catching position
+        origin = ("carrier turn after the outer (R max) dead centre (deg)"
+                  if params.mechanism == "pricking" else "carrier angle (deg, 0 = catching)")
+        jobs["clearance.png"] = lambda: clearance_figure(sweeps, angle_label=origin)
     return jobs
 
 
 def build_figures(run, *, parallel: bool | None = None) -> dict:
-    """Draw every figure of a run (half of them in a forked worker where that helps)."""
+    """Draw every figure of a run (half of them in a forked worker where that helps).
+
+    Each figure drawn is a step of stage ``plots`` on ``run.progress`` (when the run has one).
+    """
     jobs = figure_jobs(run)
+    progress = getattr(run, "progress", None)
     if parallel is None:
         parallel = _can_fork() and len(jobs) >= 4
     if not parallel:
-        figures = {name: draw() for name, draw in jobs.items()}
+        figures = {}
+        for name, draw in jobs.items():
+            figures[name] = draw()
+            if progress is not None:
+                progress.step("plots", name, steps=len(jobs))
     else:
-        figures = _draw_in_two(jobs)
+        figures = _draw_in_two(jobs, progress)
     run.figures = {name: figures[name] for name in jobs}   # the jobs' order, whoever drew
     return run.figures
 
@@ -72,7 +84,7 @@ def _can_fork() -> bool:
             and not multiprocessing.current_process().daemon)
 
 
-def _draw_in_two(jobs: dict) -> dict:
+def _draw_in_two(jobs: dict, progress=None) -> dict:
     from concurrent.futures import ProcessPoolExecutor
 
     import matplotlib
@@ -82,20 +94,49 @@ def _draw_in_two(jobs: dict) -> dict:
 
     names = list(jobs)
     theirs = names[1::2]
+    ends = progress.pipe() if progress is not None else None
     _WORKER_JOBS.clear()
     _WORKER_JOBS.update({name: jobs[name] for name in theirs})
+    _WORKER_PROGRESS.update(progress=progress, events=ends[1] if ends else None,
+                            steps=len(names))
     try:
         with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
-            future = pool.submit(_draw_worker_jobs)
-            figures = {name: jobs[name]() for name in names[0::2]}
+            future = pool.submit(_draw_worker_jobs)   # forks the worker here
+            if ends:
+                progress.relay(ends[0])
+                ends[1].close()
+            figures = {}
+            for name in names[0::2]:
+                figures[name] = jobs[name]()
+                if progress is not None:
+                    progress.step("plots", name, steps=len(names))
             figures.update(future.result())
+        if progress is not None:
+            progress.join()
     finally:
         _WORKER_JOBS.clear()
+        _WORKER_PROGRESS.clear()
     return figures
 
 
+#: The build's progress and the pipe to it, for the forked worker (as :data:`_WORKER_JOBS`).
+_WORKER_PROGRESS: dict = {}
+
+
 def _draw_worker_jobs() -> dict:
-    return {name: draw() for name, draw in _WORKER_JOBS.items()}
+    progress, events = _WORKER_PROGRESS.get("progress"), _WORKER_PROGRESS.get("events")
+    if events is not None:
+        progress.forward(events)
+    figures = {}
+    try:
+        for name, draw in _WORKER_JOBS.items():
+            figures[name] = draw()
+            if events is not None:
+                progress.step("plots", name, steps=_WORKER_PROGRESS["steps"])
+    finally:
+        if events is not None:
+            events.close()
+    return figures
 
 
 def _assembly(run) -> bytes:

@@ -9,7 +9,17 @@ import platform
 
 import numpy as np
 
-__all__ = ["input_hash", "report_dict", "assemble_report"]
+__all__ = ["input_hash", "report_dict", "assemble_report", "failures", "check_warnings",
+           "warning_count", "verdict_text", "PREDICTED_FINDINGS", "FAILING_GEAR_PROBLEMS"]
+
+#: Pricking findings that predict what the cutting check measures (the pitch curve bends
+#: tighter than a rack cuts without undercut): a warning, never a failure by themselves; the cut
+#: teeth's root thickness (gear checks, ``MIN_ROOT_THICKNESS``) decides. Where the teeth were
+#: cut, the measured check stands for the prediction and the prediction is not counted again.
+PREDICTED_FINDINGS = frozenset({"undercut"})
+#: Gear-check codes that fail a design (read from a report written before problems carried
+#: their ``severity``); ``cadgen.gears.pairs.FAILING_PROBLEMS`` is the source.
+FAILING_GEAR_PROBLEMS = frozenset({"undercut_root_too_thin"})
 
 
 def input_hash(params) -> str:
@@ -141,6 +151,7 @@ def assemble_report(run, set_aside: dict) -> dict:
         report["sweep"] = sweeps
         _replace_kinematic_estimates(report, sweeps)
     report["warnings"] = [p.as_dict() for p in getattr(run, "warnings", [])]
+    report["check_warnings"] = check_warnings(report)
     report["accuracy_achieved"] = accuracy_achieved(params, report, values, ok)
     report["stages"] = [record.as_dict() for record in run.records]
     report["failures"] = failures(report)
@@ -179,10 +190,15 @@ def failures(report: dict) -> list:
                        f"({undecided}target {metric['target']} {metric['unit']})"
                        .replace("  ", " "))
     for finding in report.get("findings", []):
-        out.append(f"[{finding['code']}] {finding['message']}")
+        if finding["code"] not in PREDICTED_FINDINGS:
+            out.append(f"[{finding['code']}] {finding['message']}")
     gear_train = report.get("gear_train", {})
     for failure in gear_train.get("failures", []):
         out.append(f"[{failure['code']}] {failure['message']}")
+    for gear in gear_train.get("gears", []):
+        for problem in gear.get("problems", []):
+            if _gear_problem_fails(problem):
+                out.append(f"gear checks: {gear['gear']} [{problem['code']}] {problem['message']}")
     for mesh in gear_train.get("meshes", []):
         if mesh["interference_poses"]:
             out.append(f"mesh {mesh['stage']}: {mesh['interference_poses']} interfering poses")
@@ -203,6 +219,56 @@ def failures(report: dict) -> list:
     return out
 
 
+
+
+def _gear_problem_fails(problem: dict) -> bool:
+    if "severity" in problem:
+        return problem["severity"] == "failure"
+    return problem["code"] in FAILING_GEAR_PROBLEMS
+
+
+def check_warnings(report: dict) -> list:
+    """Checks that hold but warn, one dict each (``check``, ``path``, ``code``, ``message``).
+
+    Every gear-check problem that does not fail the design (an undercut tooth whose root
+    thickness is adequate, a pointed tooth, ...), and each pricking prediction
+    (:data:`PREDICTED_FINDINGS`) for a gear whose teeth were not cut in this build.
+    """
+    out = []
+    gear_train = report.get("gear_train", {})
+    cut = {gear["gear"] for gear in gear_train.get("gears", [])}
+    for gear in gear_train.get("gears", []):
+        for problem in gear.get("problems", []):
+            if not _gear_problem_fails(problem):
+                out.append({"check": "gear checks", "path": f"gears.{gear['gear']}",
+                            "code": problem["code"], "message": problem["message"]})
+    for finding in report.get("findings", []):
+        gear = finding.get("path", "").removeprefix("gears.").replace("_", " ")
+        if finding["code"] in PREDICTED_FINDINGS and gear not in cut:
+            out.append({"check": "pitch-curve findings", "path": finding.get("path", ""),
+                        "code": finding["code"],
+                        "message": finding["message"] + " (its teeth were not cut in this build)"})
+    return out
+
+
+def warning_count(report: dict) -> int:
+    """Warnings of a report: checks of stages not run, and checks that hold but warn."""
+    return len(report.get("warnings") or []) + len(report.get("check_warnings")
+                                                    or check_warnings(report))
+
+
+def verdict_text(report: dict) -> str:
+    """``"PASS"``, ``"PASS, 2 warnings"``, ``"FAIL, 3 failures, 1 warning"``: the verdict in
+    words, the same in the terminal summary and the HTML header."""
+    failed = report.get("failures") or []
+    passed = report.get("passed", not failed)
+    parts = ["PASS" if passed else "FAIL"]
+    if not passed and failed:
+        parts.append(f"{len(failed)} failure{'s' * (len(failed) != 1)}")
+    warned = warning_count(report)
+    if warned:
+        parts.append(f"{warned} warning{'s' * (warned != 1)}")
+    return ", ".join(parts)
 
 
 def _searches_achieved(searches: dict) -> str:
@@ -226,9 +292,45 @@ def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
 
     Bounds where one exists (the DXF chord tolerance, the polygon of a round part, the
     cam contour's chord sag, the sweeps' certificate); the metrics' own certificate;
-    the tooth profile from the study's measured law.
+    the tooth profile from the study's measured law; for a pricking design, what its
+    inverse design achieves.
     """
     rows = []
+    if params.mechanism == "pricking" and "kinematics" in ok:
+        # what the inverse design achieves: the loop through its points, the Chebyshev fits
+        # of the carrier and needle angles, and the forward check of the inverse grid
+        from kinematics.pricking import FORWARD_TOLERANCE
+
+        inverse = values["kinematics"]
+        curve, motion = inverse.curve, inverse.motion
+        # the curve is the design: it must pass through the type-value points it was given
+        through = float(np.max(np.linalg.norm(curve(curve.knots[:-1]) - curve.points, axis=1)))
+        fits = (motion.phi1, motion.phi2)
+        pieces = sum(len(f.coefficients) for f in fits)
+        order = fits[0].coefficients.shape[1] - 1
+        # the fit stops halving a piece once its last three coefficients fall below rtol x scale
+        tail = max(float(np.abs(f.coefficients[:, -3:]).max()) for f in fits)
+        closure = max([inverse.grid_closure_error]
+                      + [float(stage.closure_error) for stage in inverse.stages])
+        grid = params.resolution.inverse_grid
+        rows += [
+            {"knob": "trajectory.degree", "value": curve.degree,
+             "achieved": f"the tip loop passes its {len(curve.points)} type-value points within "
+                         f"{through:.1e} mm, continuous to derivative {curve.degree - 1}",
+             "basis": "periodic interpolating B-spline: the residual at the points, measured"},
+            {"knob": "Chebyshev fits (fixed rtol 1e-13)",
+             "value": f"{pieces} pieces, degree {order}",
+             "achieved": f"carrier and needle angles phi1, phi2: trailing coefficients at most "
+                         f"{tail:.1e} rad",
+             "basis": "spectral decay of each piece's coefficients (pieces halved until below "
+                      "1e-13 of the angles' scale)"},
+            {"knob": "resolution.inverse_grid", "value": grid,
+             "achieved": f"tip loop rebuilt from the pitch curves within "
+                         f"{inverse.forward_deviation:.1e} mm of the designed loop (tolerance "
+                         f"{FORWARD_TOLERANCE:g} mm); the pitch curves close to {closure:.1e} rad",
+             "basis": "forward check: the pitch curves tabulated at the grid's carrier steps run "
+                      "back through the linkage (spline error ~ step^4)"},
+        ]
     if params.mechanism == "planting" and "metrics" in ok:
         accuracy = values["metrics"].accuracy
         error = accuracy["closure_centre_distance_error_mm"]

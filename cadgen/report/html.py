@@ -66,20 +66,37 @@ def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
     """Every pass/fail check the page's verdict rests on: ``(name, passed, detail)``.
 
     The design passes when all of them pass: its metric targets (planting) or
-    forward check (pricking), each clearance sweep (target met, no interference),
-    every gear cut and meshing free, the cam cuttable, every housing enclosing its
-    gears, every stage ok, and, when the report gives one (``"failures"``), the
-    report's own verdict. Gear problems such as undercut are warnings.
+    forward check and pitch-curve findings (pricking), each clearance sweep (target
+    met, no interference), every gear cut, checked and meshing free, the cam
+    cuttable, every housing enclosing its gears, every stage ok. Every failing row
+    names its own cause: a failure of the report (``"failures"``) that no row covers
+    gets a row of its own, named by it. Undercut follows one policy for both
+    mechanisms: a tooth whose remaining root thickness is at least the limit is a
+    warning, one below it fails its gear's row; the pricking kinematic undercut
+    finding is a prediction (a warning), the cut teeth decide.
     """
-    checks = []
+    from cadgen.report.content import FAILING_GEAR_PROBLEMS, PREDICTED_FINDINGS
+
+    checks, covered = [], []
     if report.get("mechanism") == "pricking":
         check = report.get("verification", {})
         checks.append(("forward kinematic check", bool(report.get("verified")),
                        f"tip loop reproduced to {_number(check.get('forward_deviation_mm'))} mm"))
+        findings = report.get("findings", [])
+        # a failing finding is a row of its own; an undercut prediction is a warning (the
+        # cut teeth decide), listed with the warnings
+        for f in findings:
+            if f["code"] not in PREDICTED_FINDINGS:
+                gear = f.get("path", "").removeprefix("gears.").replace("_", " ")
+                checks.append((f"pitch-curve findings: {gear or 'design'} "
+                               f"{f['code'].replace('_', ' ')}", False, f["message"]))
+                covered.append(f"[{f['code']}] {f['message']}")
     elif "metrics" in report:
         metrics = report["metrics"]
         met = sum(1 for m in metrics if m["passed"])
         checks.append(("metric targets", met == len(metrics), f"{met} of {len(metrics)} met"))
+        covered += [f for f in report.get("failures", [])
+                    if any(f.startswith(m["label"]) for m in metrics if not m["passed"])]
     for key, sweep in report.get("sweep", {}).items():
         ranges = sweep.get("interference_ranges_deg")
         detail = (f"minimum {_quantity(sweep.get('minimum_mm'), 'mm')}, target > "
@@ -87,35 +104,69 @@ def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
                   + (f", interference over {_degrees_ranges(ranges)}" if ranges else ""))
         checks.append((f"sweep: {_sweep_name(key, sweep)}",
                        bool(sweep.get("passed")) and not ranges, detail))
+        covered.append(f"{sweep.get('label', '')}:")
     train = report.get("gear_train")
     if train is not None:
         failures = train.get("failures", [])
         checks.append(("gears cut", not failures,
-                       f"{len(failures)} could not be cut" if failures else
+                       f"{len(failures)} could not be cut: "
+                       + ", ".join(f["message"].split(" gear cannot")[0].removeprefix("the ")
+                                   for f in failures) if failures else
                        _plural(len(train.get("gears", [])), "gear") + " cut"))
+        covered += [f"[{f['code']}]" for f in failures]
+        gears = train.get("gears", [])
+        bad = False
+        for gear in gears:
+            for problem in gear.get("problems", []):
+                fails = (problem["severity"] == "failure" if "severity" in problem
+                         else problem["code"] in FAILING_GEAR_PROBLEMS)
+                if fails:
+                    bad = True
+                    cause = ("undercut below the root-thickness limit"
+                             if problem["code"] == "undercut_root_too_thin"
+                             else problem["code"].replace("_", " "))
+                    checks.append((f"gear checks: {gear['gear']} {cause}", False,
+                                   problem["message"]))
+        if gears and not bad:
+            warned = sum(1 for g in gears for p in g.get("problems", []))
+            undercut = sum(1 for g in gears if g.get("undercut_teeth"))
+            limit = next((g["root_thickness_limit_mm"] for g in gears
+                          if g.get("root_thickness_limit_mm")), None)
+            detail = (_plural(len(gears), "gear") + " checked"
+                      + (f"; {_plural(undercut, 'gear')} undercut within the root-thickness "
+                         f"limit ({_plural(warned, 'warning')})" if undercut else
+                         f"; {_plural(warned, 'warning')}" if warned else ""))
+            if limit and undercut:
+                detail += f"; limit {_number(limit)} mm at the first module"
+            checks.append(("gear checks", True, detail))
+        covered.append("gear checks:")
         if train.get("meshes"):
             bad = [m["stage"] for m in train["meshes"] if m["interference_poses"]]
             detail = ", ".join(bad) or _plural(len(train["meshes"]), "mesh", "meshes") + " checked"
             checks.append(("gear meshes free of interference", not bad, detail))
+            covered.append("mesh ")
     if "cam" in report:
         cam = report["cam"]
         ok = bool(cam.get("cuttable", True)) and not cam.get("problems")
         detail = "cuttable" if ok else _plural(len(cam.get("problems", [])), "problem")
         checks.append(("cam", ok, detail))
+        covered += [f"[{p['code']}]" for p in cam.get("problems", [])]
     if "solids" in report:
         rows = report["solids"].get("enclosure", [])
         ok = all(r.get("gears_enclosed", True) and r.get("axial_fit", True) for r in rows)
         checks.append(("housings enclose their gears", ok, _plural(len(rows), "housing")))
+        covered += [f"{r['housing']} does not enclose" for r in rows]
     if "stages" in report:
         bad = [f"{s['stage']} {s.get('status')}" for s in report["stages"]
                if s.get("status", "ok") != "ok"]
         checks.append(("stages ran", not bad, ", ".join(bad) or
                        _plural(len(report["stages"]), "stage") + " ok"))
-    if "failures" in report:
-        failures = report["failures"]
-        checks.append(("report verdict", bool(report.get("passed", not failures)),
-                       "no failures" if not failures else
-                       _plural(len(failures), "failure") + " listed below"))
+        covered.append("stage ")
+    # a failure no row above covers (a report from elsewhere, a new kind): its own row
+    for failure in report.get("failures") or []:
+        if not any(failure.startswith(prefix) for prefix in covered if prefix):
+            name = failure if len(failure) <= 80 else failure[:79].rstrip() + "…"
+            checks.append((name, False, failure))
     return checks
 
 
@@ -160,16 +211,29 @@ def _preset_html(preset) -> str:
 
 
 def _header(report: dict) -> str:
+    from cadgen.report.content import check_warnings
+
     checks = overall_checks(report)
-    passed = all(ok for _, ok, _ in checks)
+    passed = all(ok for _, ok, _ in checks) and report.get("passed", True)
     failed = sum(1 for _, ok, _ in checks if not ok)
     state = "pass" if passed else "fail"
-    detail = (f"all {len(checks)} checks met" if passed
-              else f"{failed} of {len(checks)} checks failed")
-    warned = len(report.get("warnings") or [])
-    if warned:   # checks of stages this build did not run, listed below the checks
-        detail += f"; {warned} warning{'s' * (warned > 1)} (stages not run)"
-    verdict = f'<span class="badge verdict {state}">{state.upper()}</span>{_e(detail)}'
+    # the verdict as the terminal summary words it ("PASS, 2 warnings"), then the checks
+    held = report.get("check_warnings")
+    held = check_warnings(report) if held is None else held
+    stage_warned = len(report.get("warnings") or [])
+    warned = stage_warned + len(held)
+    failures = report.get("failures") or []
+    words = [f"{len(failures)} failure{'s' * (len(failures) != 1)}"] if failures and not passed \
+        else []
+    if warned:
+        words.append(f"{warned} warning{'s' * (warned != 1)}"
+                     + (" (stages not run)" if not held else
+                        f" ({stage_warned} of stages not run)" if stage_warned else ""))
+    detail = "; ".join(([", ".join(words)] if words else [])
+                       + [f"all {len(checks)} checks met" if passed
+                          else f"{failed} of {len(checks)} checks failed"])
+    verdict = (f'<span title="{_e(state.upper())}{_e(", " + ", ".join(words) if words else "")}"'
+               f' class="badge verdict {state}">{state.upper()}</span>{_e(detail)}')
     facts = {"mechanism": f"{report.get('mechanism', '?')} mechanism"}
     if "scene" in report:
         scene = report["scene"]
@@ -193,6 +257,8 @@ def _header(report: dict) -> str:
                           row_classes=["" if ok else "fail" for _, ok, _ in checks]),
                    f'<table class="kv"><tbody>{rows}</tbody></table>')
             + _failure_list(report.get("failures"))
+            + (f"<h3>Warnings: checks that hold with a warning ({len(held)})</h3>"
+               + _problem_list(held, state="warn") if held else "")
             + _warning_list(report.get("warnings")) + "</header>")
 
 
@@ -214,13 +280,49 @@ def _natural_key(text: str):
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", text)]
 
 
+#: Captions of the figures a build draws, by file stem (others are made from the name).
+_CAPTIONS = {
+    "relative_path": "Relative tip path, both arms at the catching pose",
+    "absolute_paths": "Absolute tip paths per plant spacing",
+    "attitude": "Planter attitude over a carrier turn",
+    "tip_velocity": "Tip speed, relative and absolute",
+    "pitch_curves": "Pitch curves",
+    "cam-follower": "Cam follower: roller lift, lever angle, blade opening and mouth",
+    "cam-contour": "Cam contour",
+    "assembly": "Assembly (front view)",
+    "clearance": "Clearances of the solids (FCL sweep)",
+    "loop": "Needle-tip loop and linkage",
+    "ratio": "Transmission ratios",
+    "field_paths": "Field paths per inclination",
+}
+
+
+def _gear_pair_words(slug: str) -> str:
+    """A gear pair's name back from its file-name slug: ``"1-1-pair-d-to-e"`` -> ``"1:1 pair D to
+    E"``, ``"train-1-sun-to-idler-1"`` -> ``"train 1: sun to idler 1"``, ``"non-circular-pair"``
+    stays hyphenated."""
+    text = re.sub(r"^(\d+)-(\d+)-pair\b", r"\1:\2 pair", slug)
+    text = re.sub(r"\btrain-(\d+)-(?=[a-z])", r"train \1: ", text)
+    text = text.replace("non-circular", "non\0circular")   # a hyphen the next line keeps
+    text = text.replace("-", " ").replace("\0", "-")
+    # single letters are the mechanism's points (gear D, planet gear E)
+    return re.sub(r"\b([a-z])\b", lambda m: m[1].upper(), text)
+
+
 def figure_caption(name: str) -> str:
-    """A caption from a figure's file name: ``"gears-3-train-1-sun-to-idler-1.png"`` ->
-    ``"Gear pair 3: train 1 sun to idler 1"``, ``"tip_velocity.png"`` -> ``"Tip velocity"``."""
+    """A readable caption from a figure's file name.
+
+    ``"gears-2-1-1-pair-d-to-e.png"`` -> ``"Gear pair 2: 1:1 pair D to E"``,
+    ``"gears-3-train-1-sun-to-idler-1.png"`` -> ``"Gear pair 3: train 1: sun to idler 1"``,
+    ``"tip_velocity.png"`` -> ``"Tip speed, relative and absolute"`` (the figures a build draws
+    have captions of their own), ``"mystery_plot.png"`` -> ``"Mystery plot"``.
+    """
     stem = Path(name).stem
     match = re.fullmatch(r"gears-(\d+)-(.+)", stem)
     if match:
-        return f"Gear pair {match[1]}: {match[2].replace('-', ' ')}"
+        return f"Gear pair {match[1]}: {_gear_pair_words(match[2])}"
+    if stem in _CAPTIONS:
+        return _CAPTIONS[stem]
     words = re.sub(r"[-_]+", " ", stem).strip()
     return words[:1].upper() + words[1:] if words else name
 
@@ -269,7 +371,8 @@ def _figures_section(figures: dict) -> str:
 # page
 
 
-def render_html(report: dict, figures: dict[str, bytes] | None = None) -> str:
+def render_html(report: dict, figures: dict[str, bytes] | None = None, *,
+                animation: dict | None = None, assembly_glb: bytes | None = None) -> str:
     """The report and its figures as one self-contained HTML page.
 
     Parameters
@@ -281,6 +384,10 @@ def render_html(report: dict, figures: dict[str, bytes] | None = None) -> str:
     figures : dict of str to bytes, optional
         PNG files by file name (``"attitude.png"``); embedded as ``data:`` URIs and
         grouped by what they show.
+    animation, assembly_glb : optional
+        The mechanism's poses (:func:`cadgen.report.animation.animation_data`) and
+        ``solids/assembly.glb``: an animation and a 3D view, each with its inline
+        script (:mod:`cadgen.report.viewer`); without them the page has no scripts.
 
     Returns
     -------
@@ -306,7 +413,10 @@ def render_html(report: dict, figures: dict[str, bytes] | None = None) -> str:
     else:
         mechanism = [_metrics_section(report), _sweep_section(report),
                      _planting_motion_section(report)]
-    sections = [*mechanism, _gears_section(report), _cam_section(report),
+    from cadgen.report.viewer import interactive_sections
+
+    sections = [*mechanism, *interactive_sections(animation, assembly_glb),
+                _gears_section(report), _cam_section(report),
                 _solids_section(report), _figures_section(figures), _stages_section(report),
                 _accuracy_section(report), _parameters_section(report)]
     sections = [s for s in sections if s]

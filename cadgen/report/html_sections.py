@@ -77,10 +77,62 @@ def _planting_motion_section(report: dict) -> str:
             ["spacing", "hole width", "verticality", "span", "x entry (mm)", "x exit (mm)",
              "x lowest (mm)", "tip velocity at lowest point"], rows, numeric=tuple(range(8))))
     if "derived" in report:
-        parts.append("<h3>Derived geometry</h3>" + _key_values(report["derived"]))
+        derived = {k: v for k, v in report["derived"].items() if k not in _CLEARANCE_KEYS}
+        if "housing_circles_mm" in derived:   # an input of the kinematic clearance model
+            derived["housing_circles_kinematic_model_mm"] = derived.pop("housing_circles_mm")
+        parts.append("<h3>Derived geometry</h3>" + _key_values(derived))
+        parts.append(_clearance_methods(report))
     if not parts:
         return ""
     return _section("motion", "Planting motion and derived geometry", "".join(parts))
+
+
+#: Derived-geometry keys of the kinematic clearance estimates, shown by method instead.
+_CLEARANCE_KEYS = ("arm_distance_at_deg", "ground_clearance_at_deg", "ground_clearance_nearest",
+                   "clearance_method")
+
+
+def _clearance_methods(report: dict) -> str:
+    """The clearances by method: the kinematic estimate (centre lines and housing circles,
+    from the metrics stage) beside the FCL minimum on the solids, each with where it occurs."""
+    derived, sweeps = report.get("derived", {}), report.get("sweep", {})
+    metrics = {m.get("key"): m for m in report.get("metrics", [])}
+    rows = []
+    for key, sweep_key, where_key, nearest in (
+            ("arm_distance", "arm_interference", "arm_distance_at_deg", None),
+            ("ground_clearance", "ground_clearance", "ground_clearance_at_deg",
+             derived.get("ground_clearance_nearest"))):
+        if where_key not in derived and sweep_key not in sweeps:
+            continue
+        metric = metrics.get(key, {})
+        sweep = sweeps.get(sweep_key)
+        # with a sweep the metric's value is the solids' and the estimate stands beside it
+        estimate = metric.get("kinematic_estimate", None if sweep else metric.get("value"))
+        kinematic = (f"{_quantity(estimate, 'mm')} at " if estimate is not None else "") + \
+            _quantity(derived.get(where_key), "deg", 2) + (f" ({nearest})" if nearest else "")
+        solids = ("not run in this build" if sweep is None else
+                  f"{_quantity(sweep.get('minimum_mm'), 'mm')} at "
+                  f"{_quantity(sweep.get('carrier_angle_deg'), 'deg', 2)} "
+                  f"({' ↔ '.join(map(str, sweep.get('nearest') or []))})")
+        rows.append([_e(key.replace("_", " ")), _e(kinematic), _e(solids)])
+    if not rows:
+        return ""
+    method = str(derived.get("clearance_method", "centre lines and housing circles"))
+    method = method.removeprefix("kinematic: ")
+    return ("<h3>Clearances by method</h3>"
+            + _table(["clearance", f"kinematic estimate ({method}), carrier angle of arm 1",
+                      "FCL on the solids (certified minimum), carrier angle"], rows)
+            + '<p class="note">The kinematic estimates come from the metrics stage, the FCL '
+              "minima from the solids' sweep (the values the checks use). The two arms take "
+              "each other's poses every half turn, so a carrier angle and that angle plus "
+              "180 deg give the same clearance with the arms swapped.</p>")
+
+
+def _signed_windows(ranges) -> str:
+    """Carrier-progress windows around the outer dead centre: ``-77.9 to 51.9 deg``."""
+    if not ranges:
+        return "none"
+    return ", ".join(f"{_number(a, 1)} to {_number(b, 1)} deg" for a, b in ranges)
 
 
 def _pricking_section(report: dict) -> str:
@@ -93,7 +145,7 @@ def _pricking_section(report: dict) -> str:
                      _e(_quantity(r["needle_exit_angle_deg"], "deg", 2)),
                      _e(_quantity(r["hole_mouth_mm"], "mm", 2)),
                      _e(_quantity(r["time_in_soil_deg"], "deg", 1)),
-                     _e(_degrees_ranges(r.get("slow_windows_deg"))),
+                     _e(_signed_windows(r.get("slow_windows_deg"))),
                      _e(_quantity(r["slow_window_total_deg"], "deg", 1)),
                      _e(_quantity(r["projected_height_mm"], "mm", 1)),
                      _e(_quantity(r["width_mm"], "mm", 1)),
@@ -101,10 +153,12 @@ def _pricking_section(report: dict) -> str:
         classes.append("fail" if root else "")
     note = (f"carrier at {_number(field.get('carrier_speed_rpm'), trim=True)} r/min, forward "
             f"speed {_number(field.get('forward_speed_mm_s'), trim=True)} mm/s, depth "
-            f"{_number(field.get('depth_mm'), trim=True)} mm; {field.get('angles', '')}")
+            f"{_number(field.get('depth_mm'), trim=True)} mm; {field.get('angles', '')}; slow "
+            "windows are carrier progress around the outer (R max) dead centre, negative "
+            "before it, so a window across it reads -77.9 to 51.9 deg, not 282.1 to 411.9")
     note = f'<p class="note">{_e(note)}</p>'
     body = [note, _table(["inclination", "needle entry", "needle exit", "hole mouth", "in soil",
-                          "slow windows", "slow total", "height", "width", "needle root in soil"],
+                          "slow windows (from R max)", "slow total", "height", "width", "needle root in soil"],
                          rows, numeric=(0, 1, 2, 3, 4, 6, 7, 8), row_classes=classes)]
     findings = report.get("findings", [])
     # Newer reports count findings among their failures; older ones only warn.
@@ -276,11 +330,52 @@ def _stages_section(report: dict) -> str:
     return _section("stages", "Stages", _table(headers, rows, numeric=(1,), row_classes=classes))
 
 
+def _searches_table(searches: dict) -> str:
+    """The certified searches; a maximum (the highest point) carries an upper bound."""
+    rows = []
+    for name, search in searches.items():
+        value, bound = search.get("value"), search.get("certified_bound")
+        label = name.replace("_", " ")
+        if search.get("maximum"):
+            label += " (a maximum: its bound is an upper one)"
+        elif name in ("arm_distance", "ground_clearance"):
+            label += " (kinematic estimate)"
+        rows.append([_e(label), _e(_number(value, 9)), _e(_number(bound, 9)),
+                     "yes" if search.get("certified") else _badge("warn") + " no",
+                     _e(_scientific(search.get("gap"))), _e(_scientific(search.get("atol"))),
+                     "yes" if search.get("budget_spent") else "no",
+                     _e(_number(search.get("refined_intervals"))),
+                     _e(_number(search.get("evaluations")))])
+    return _table(["search", "value (mm)", "certified bound (mm)", "certified", "gap", "atol",
+                   "budget spent", "refined intervals", "evaluations"], rows,
+                  numeric=(1, 2, 4, 5, 7, 8))
+
+
 def _accuracy_section(report: dict) -> str:
-    if not report.get("accuracy"):
+    """What the build's resolution achieved: per knob (``accuracy_achieved``), then the
+    metrics' own accuracy figures (``accuracy``, planting) or the forward check (pricking)."""
+    achieved = report.get("accuracy_achieved") or []
+    accuracy = dict(report.get("accuracy") or {})
+    verification = report.get("verification") if report.get("mechanism") == "pricking" else None
+    if not (achieved or accuracy or verification):
         return ""
-    # More digits than elsewhere: here the point is how far apart value and bound are.
-    return _section("accuracy", "Accuracy achieved", _key_values(report["accuracy"], digits=9))
+    body = []
+    if achieved:
+        rows = [[f"<code>{_e(r.get('knob', ''))}</code>", _e(str(r.get("value", ""))),
+                 _e(r.get("achieved", "")), _e(r.get("basis", ""))] for r in achieved]
+        body.append("<h3>What each resolution knob buys</h3>"
+                    + _table(["knob", "value", "achieved", "basis"], rows, numeric=(1,)))
+    if verification:
+        body.append("<h3>Forward check of the inverse design</h3>"
+                    + _key_values(verification))
+    if accuracy:
+        searches = accuracy.pop("minimum_searches", None)
+        # More digits than elsewhere: here the point is how far apart value and bound are.
+        body.append("<h3>Metrics: closure and searches</h3>" + _key_values(accuracy, digits=9))
+        if searches:
+            body.append("<h3>Certified minimum searches of the metrics (kinematic model)</h3>"
+                        + _searches_table(searches))
+    return _section("accuracy", "Accuracy achieved", "".join(body))
 
 
 def _parameters_section(report: dict) -> str:

@@ -84,7 +84,9 @@ def pricking_summary(report: dict) -> str:
 
     link, gears, check = report["linkage"], report["gears"], report["verification"]
     teeth, modules = gears["teeth"], gears["modules_mm"]
-    lines = [f"design {report['design']} (pricking mechanism): "
+    from cadgen.report.content import verdict_text
+
+    lines = [f"design {report['design']} (pricking mechanism): {verdict_text(report)}; "
              f"{'verified' if report['verified'] else 'NOT VERIFIED'}, "
              f"{len(report['findings'])} finding{'s' if len(report['findings']) != 1 else ''}",
              f"linkage: a = {n(link['centre_distance_a_mm'], '.4f')} mm, l = "

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 __all__ = ["summary_text", "format_metrics_table", "format_gear_table", "format_cam",
-           "format_solids", "format_clearances", "format_stages"]
+           "format_solids", "format_clearances", "format_stages", "format_verdict"]
 
 #: Printed for a number the report does not have.
 MISSING = "n/a"
@@ -60,9 +60,28 @@ def format_stages(report: dict) -> str:
         lines.append(line)
     for effect, reason in report.get("scene", {}).get("set_aside", {}).items():
         lines.append(f"  (effect {effect} not run: {reason})")
-    verdict = "PASSED" if report.get("passed") else "NOT PASSED: " + "; ".join(
-        report.get("failures", [])[:6])
-    return "stages:\n" + "\n".join(lines) + f"\n{verdict}"
+    return "stages:\n" + "\n".join(lines) + "\n" + format_verdict(report)
+
+
+#: Failure reasons printed under NOT PASSED; the rest are counted and left to the report.
+FAILURES_SHOWN = 5
+
+
+def format_verdict(report: dict, shown: int = FAILURES_SHOWN) -> str:
+    """``PASSED``, or ``NOT PASSED:`` and one indented line per reason, the first ``shown``
+    of them, then ``and N more (see report.html)`` (report.json when no page was written)."""
+    if report.get("passed"):
+        return "PASSED"
+    failures = [" ".join(str(f).split()) for f in report.get("failures", [])]
+    lines = ["NOT PASSED:" if failures else "NOT PASSED"]
+    lines += [f"  - {reason}" for reason in failures[:shown]]
+    rest = len(failures) - shown
+    if rest > 0:
+        files = report.get("files") or ()
+        where = ("report.html" if "report.html" in files
+                 else "report.json" if "report.json" in files else "the report")
+        lines.append(f"  and {rest} more (see {where})")
+    return "\n".join(lines)
 
 
 def format_clearances(sweep: dict) -> str:
@@ -99,8 +118,11 @@ def format_metrics_table(report: dict) -> str:
                   else "pass" if m["passed"] else "FAIL")
         rows.append((m["label"], spacing, value, target, status))
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    from cadgen.report.content import verdict_text
+
+    met = all(m["passed"] for m in report["metrics"])
     lines = [f"design {report['design']} ({report['mechanism']} mechanism): "
-             f"{'all targets met' if report['passed'] else 'TARGETS MISSED'}"]
+             f"{verdict_text(report)}; {'all targets met' if met else 'TARGETS MISSED'}"]
     for k, row in enumerate(rows):
         lines.append("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
         if k == 0:

@@ -1,4 +1,5 @@
-"""What every figure of a report shares: an Agg figure with fixed margins, filled outlines, PNG bytes."""
+"""What every figure of a report shares: an Agg figure with fixed margins, filled outlines,
+legends and event names kept off the data, PNG bytes."""
 
 from __future__ import annotations
 
@@ -6,7 +7,10 @@ import io
 
 import numpy as np
 
-__all__ = ["_figure", "_fill", "_png"]
+__all__ = ["DPI", "_figure", "_fill", "_png", "_legend_below", "_event_ticks"]
+
+#: Resolution of every figure: fine enough to print at the page's width (110 was too coarse).
+DPI = 150
 
 
 def _figure(width=7.5, height=5.0, **layout):
@@ -17,8 +21,40 @@ def _figure(width=7.5, height=5.0, **layout):
     import matplotlib.pyplot as plt
 
     # constrained layout is solved at the one draw; tight_layout would draw the figure twice
-    figure, axes = plt.subplots(figsize=(width, height), dpi=110, layout="constrained", **layout)
+    figure, axes = plt.subplots(figsize=(width, height), dpi=DPI, layout="constrained", **layout)
     return figure, axes
+
+
+def _legend_below(figure, handles=None, labels=None, *, ncols=2, fontsize=8):
+    """One legend for the whole figure, under the axes, so that it covers no data.
+
+    ``handles``/``labels`` default to every labelled artist of every axes of the figure
+    (twin axes included, each label once).
+    """
+    if handles is None:
+        handles, labels, seen = [], [], set()
+        for ax in figure.axes:
+            for handle, label in zip(*ax.get_legend_handles_labels()):
+                if label not in seen:
+                    seen.add(label)
+                    handles.append(handle)
+                    labels.append(label)
+    if handles:
+        figure.legend(handles, labels, loc="outside lower center", ncols=ncols,
+                      fontsize=fontsize, frameon=False)
+
+
+def _event_ticks(ax, events: dict, *, fontsize=7, rotation=0):
+    """Name events (``{name: x}``) on a second x axis above the plot, not on the curves."""
+    top = ax.secondary_xaxis("top")
+    names = list(events)
+    top.set_xticks([events[name] for name in names], names)
+    top.tick_params(labelsize=fontsize, length=3, pad=1)
+    if rotation:
+        for label in top.get_xticklabels():
+            label.set_rotation(rotation)
+            label.set_horizontalalignment("left")
+    return top
 
 
 def _fill(ax, x, y, **style):

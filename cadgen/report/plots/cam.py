@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cadgen.report.plots.base import _figure, _fill, _png
+from cadgen.report.plots.base import _event_ticks, _figure, _fill, _legend_below, _png
 
 __all__ = ["cam_figures", "cam_figure_jobs"]
 
@@ -13,36 +13,50 @@ _EVENT_STYLE = {"entry": "tab:brown", "lowest": "k", "exit": "tab:brown",
 
 
 def follower_motion(design) -> bytes:
-    """Lever angle, roller lift and blade opening (with the mouth) vs carrier angle, events marked."""
+    """Roller lift and lever angle (top, each on its own axis), blade opening and mouth
+    (bottom, each on its own axis) vs carrier angle; events named above, every line labelled."""
+    import matplotlib.patches as patches
+
     phi = np.linspace(0.0, 2 * np.pi, 1441)
     lam, lift, beta = design.profile.follower_at_carrier(phi, design.cam_angle)
-    figure, (top, bottom) = _figure(8.0, 6.0, nrows=2, sharex=True)
+    figure, (top, bottom) = _figure(8.0, 6.5, nrows=2, sharex=True)
     degrees = np.degrees(phi)
-    top.plot(degrees, lift, color="tab:blue", label="roller lift (mm)")
-    top.plot(degrees, np.degrees(lam), color="tab:purple", ls="--", label="lever angle (deg)")
-    top.set_ylabel("follower")
-    bottom.plot(degrees, np.degrees(beta), color="tab:red", label="blade opening (deg)")
+    top.plot(degrees, lift, color="tab:blue", label="roller lift (mm, left axis)")
+    top.set_ylabel("roller lift (mm)", color="tab:blue")
+    lever = top.twinx()
+    lever.plot(degrees, np.degrees(lam), color="tab:purple", ls="--",
+               label="lever angle (deg, right axis)")
+    lever.set_ylabel("lever angle (deg)", color="tab:purple")
+    bottom.plot(degrees, np.degrees(beta), color="tab:red", label="blade opening (deg, left axis)")
+    bottom.set_ylabel("blade opening (deg)", color="tab:red")
     mouth = design.linkage.mouth_width(beta)
     twin = bottom.twinx()
-    twin.plot(degrees, mouth, color="tab:orange", ls=":", label="mouth (mm)")
-    twin.axhline(design.linkage.required_mouth, color="tab:orange", lw=0.8, alpha=0.6)
-    twin.set_ylabel("mouth (mm)")
-    bottom.set_ylabel("blade opening (deg)")
+    twin.plot(degrees, mouth, color="tab:orange", ls=":", label="mouth width (mm, right axis)")
+    twin.axhline(design.linkage.required_mouth, color="tab:orange", lw=0.8, alpha=0.6,
+                 label=f"required mouth {design.linkage.required_mouth:g} mm (right axis)")
+    twin.set_ylabel("mouth width (mm)", color="tab:orange")
     bottom.set_xlabel("carrier angle (deg, 0 = catching)")
+    events = {name.replace("_", " "): np.degrees(angle)
+              for name, angle in design.timing.events.items() if name != "catching"}
     for name, angle in design.timing.events.items():
         if name == "catching":
             continue
         for axes in (top, bottom):
             axes.axvline(np.degrees(angle), color=_EVENT_STYLE.get(name, "0.5"), lw=0.8, ls="-.")
-        top.annotate(name.replace("_", " "), (np.degrees(angle), 1.0), xycoords=("data", "axes fraction"),
-                     rotation=90, va="top", ha="right", fontsize=7)
+    _event_ticks(top, events, rotation=30)
     for start, end in (design.timing.opening, design.timing.closing):
         top.axvspan(np.degrees(start), np.degrees(end), color="0.85", zorder=0)
-    top.legend(loc="upper left", fontsize=8)
-    bottom.legend(loc="upper left", fontsize=8)
-    twin.legend(loc="upper right", fontsize=8)
+    handles, labels = [], []
+    for axes in (top, lever, bottom, twin):
+        h, lab = axes.get_legend_handles_labels()
+        handles += h
+        labels += lab
+    handles.append(patches.Patch(color="0.85"))
+    labels.append("cam opening, closing (shaded)")
+    _legend_below(figure, handles, labels, ncols=3, fontsize=7)
     top.set_title("Duckbill cam: closed through catching and transport, open from the lowest "
-                  "point until the seedling is cleared", fontsize=9)
+                  "point\nuntil the seedling is cleared (dash-dot lines: events named above)",
+                  fontsize=9)
     for axes in (top, bottom):
         axes.grid(alpha=0.3)
         axes.set_xlim(0, 360)
@@ -52,7 +66,7 @@ def follower_motion(design) -> bytes:
 def contour(design, points: int) -> bytes:
     """The cam contour with its pitch curve, base circle and the checks' worst places."""
     profile, check = design.profile, design.check
-    figure, ax = _figure(6.5, 6.5)
+    figure, ax = _figure(6.5, 7.2)
     working = profile.working_profile(points)
     pitch = profile.pitch_curve(points)
     _fill(ax, working[:, 0], working[:, 1], color="0.8", label="cam (working profile)")
@@ -71,7 +85,9 @@ def contour(design, points: int) -> bytes:
     ax.set_title(f"Cam: pressure angle max {np.degrees(check.pressure_angle_max):.1f} deg, "
                  f"smallest convex pitch radius {check.pitch_radius_convex_min:.2f} mm "
                  f"(roller {profile.roller_radius:g} mm)", fontsize=9)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.set_xlabel("x (mm, cam frame)")
+    ax.set_ylabel("y (mm)")
+    _legend_below(figure, ncols=2)
     ax.grid(alpha=0.3)
     return _png(figure)
 

@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 
-from cadgen.report.plots.base import _figure, _fill, _png
+from cadgen.report.plots.base import _figure, _fill, _legend_below, _png
 from kinematics.planar import cross
 
 __all__ = ["assembly_view", "pair_figure_jobs", "pair_figures", "clearance_figure"]
@@ -60,8 +60,14 @@ def assembly_view(assembly, angle: float, *, title: str, paths=(), soil_level=No
     ax.set_ylabel("y (mm)")
     ax.set_title(title, fontsize=9)
     if paths or soil_level is not None:
-        ax.legend(fontsize=7, loc="upper right")
+        _legend_below(figure, ncols=2)
     ax.grid(alpha=0.2)
+    # the figure takes the drawing's proportions, so a wide, low machine is not drawn small
+    # in white space (about 1.4 in of title, labels and legend around the axes)
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    width = 7.0
+    figure.set_size_inches(width, float(np.clip((width - 0.8) * abs(y1 - y0) / abs(x1 - x0)
+                                                + 1.4, 3.5, 9.0)))
     return _png(figure)
 
 # ----------------------------------------------------------------------------------------------
@@ -94,38 +100,59 @@ def _pair_figure(stage) -> bytes:
     ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
                  f"{m.interference_poses} interfering poses of {m.poses}, "
                  f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
+    ax.plot([], [], "k:", lw=0.6, label="pitch curves")
     ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="upper right")
+    ax.set_xlabel("x (mm, along the centre line)")
+    ax.set_ylabel("y (mm)")
+    _legend_below(figure, ncols=3)
     ax.grid(alpha=0.2)
     return _png(figure)
 
 # ----------------------------------------------------------------------------------------------
 # Clearances over the sweep
 
-def clearance_figure(sweeps: dict) -> bytes:
+def clearance_figure(sweeps: dict, *, angle_label: str = "carrier angle (deg, 0 = catching)"
+                     ) -> bytes:
     """Minimum distance between the solids vs carrier angle, per sweep, the minimum and target
-    marked, interference ranges shaded."""
-    figure, ax = _figure(8.0, 4.5)
+    marked, interference ranges shaded.
+
+    ``angle_label`` names the angle's origin (the planting mechanism counts from the catching
+    position, the pricking one from the outer dead centre). A sweep that covers half a turn
+    (the two planting arms swap every half turn, so their distance repeats) is drawn over the
+    second half too, dashed, so that its end at 180 deg reads as the start again.
+    """
+    figure, ax = _figure(8.0, 5.0)
     colours = {"arm_interference": "tab:blue", "ground_clearance": "tab:brown"}
     for key, sweep in sweeps.items():
         samples = sweep["samples"]
         colour = colours.get(key, "k")
-        ax.plot(samples["carrier_angle_deg"], samples["distance_mm"], color=colour,
-                label=sweep["label"])
+        angles = np.asarray(samples["carrier_angle_deg"], dtype=float)
+        distances = np.asarray(samples["distance_mm"], dtype=float)
+        ax.plot(angles, distances, color=colour, label=sweep["label"])
+        span = angles[-1] - angles[0] if len(angles) else 360.0
+        if 0.0 < span <= 180.0 + 1e-6:
+            ax.plot(angles + span, distances, color=colour, ls="--", lw=0.9, alpha=0.7,
+                    label=f"{sweep['label']}: repeats every {span:g} deg (the arms swap)")
         ax.axhline(sweep["target_mm"], color=colour, ls=":", lw=1.0,
-                   label=f"target > {sweep['target_mm']:g} mm")
-        ax.plot([sweep["carrier_angle_deg"]], [sweep["minimum_mm"]], "o", color=colour)
-        ax.annotate(f"{sweep['minimum_mm']:.2f} mm", (sweep["carrier_angle_deg"],
-                                                      sweep["minimum_mm"]),
-                    textcoords="offset points", xytext=(5, 5), fontsize=8, color=colour)
+                   label=f"target > {sweep['target_mm']:g} mm ({sweep['label']})")
+        angle = sweep["carrier_angle_deg"]
+        ax.plot([angle], [sweep["minimum_mm"]], "o", color=colour,
+                label=f"certified minimum {sweep['minimum_mm']:.2f} mm at {angle:.2f} deg")
+        # the number beside its point, on the side with room (inside the axes)
+        right = angle < 300
+        ax.annotate(f"{sweep['minimum_mm']:.2f} mm", (angle, sweep["minimum_mm"]),
+                    textcoords="offset points", xytext=(6 if right else -6, -12),
+                    ha="left" if right else "right", fontsize=8, color=colour,
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                          "alpha": 0.8})
         for start, end in sweep.get("interference_ranges_deg") or []:
             ax.axvspan(start, end, color="red", alpha=0.2)
     ax.set_xlim(0, 360)
     ax.set_ylim(bottom=min(0.0, ax.get_ylim()[0]))
-    ax.set_xlabel("carrier angle (deg, 0 = catching)")
+    ax.set_xlabel(angle_label)
     ax.set_ylabel("minimum distance between the solids (mm)")
     ax.set_title("Clearances of the solids over a revolution (FCL, certified minimum marked)",
                  fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    _legend_below(figure, ncols=2, fontsize=7)
     return _png(figure)

@@ -6,7 +6,7 @@ import numpy as np
 
 __all__ = ["planting_figures", "planting_figure_jobs"]
 
-from cadgen.report.plots.base import _figure, _png  # noqa: E402
+from cadgen.report.plots.base import _event_ticks, _figure, _legend_below, _png  # noqa: E402
 
 
 def _events_deg(evaluation):
@@ -15,7 +15,7 @@ def _events_deg(evaluation):
 
 
 def relative_path(mechanism, evaluation, phi):
-    figure, ax = _figure(6.5, 7.5)
+    figure, ax = _figure(5.5, 8.0)
     for arm, colour in ((0, "tab:blue"), (1, "tab:orange")):
         tip = mechanism.motion(phi, "N", arm).position
         ax.plot(tip[:, 0], tip[:, 1], color=colour, lw=1.2, label=f"tip N, arm {arm + 1}")
@@ -30,18 +30,20 @@ def relative_path(mechanism, evaluation, phi):
         ax.add_patch(__import__("matplotlib.patches", fromlist=["Circle"]).Circle(
             centre, circle.radius, fill=False, ls=":", color="0.4"))
     ax.axhline(evaluation.events.soil_level, color="saddlebrown", lw=1.5, label="soil surface")
+    ax.plot([], [], ":", color="0.4", label="gearbox 2 housing circles")
+    ax.plot([], [], "-o", color="0.5", ms=4, label="carrier O-C, arm C-E-P1-N")
     ax.plot([0], [0], "k+", ms=12)
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm, forward travel)")
     ax.set_ylabel("y (mm)")
-    ax.set_title("Relative tip path (bench idle run), both arms at the catching pose")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title("Relative tip path (bench idle run),\nboth arms at the catching pose", fontsize=10)
+    _legend_below(figure, ncols=2)
     ax.grid(alpha=0.3)
     return _png(figure)
 
 
 def absolute_paths(mechanism, evaluation, phi):
-    figure, ax = _figure(9.0, 5.0)
+    figure, ax = _figure(5.8, 8.0)
     tip = mechanism.motion(phi, "N").position
     for hole in evaluation.holes:
         x = tip[:, 0] + hole.spacing / np.pi * phi
@@ -54,24 +56,29 @@ def absolute_paths(mechanism, evaluation, phi):
     ax.set_aspect("equal")
     ax.set_xlabel("X (mm, forward travel)")
     ax.set_ylabel("Y (mm)")
-    ax.set_title("Absolute tip paths over one carrier revolution (| = soil entry, exit)")
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    ax.set_title("Absolute tip paths over one carrier revolution\n(| = soil entry, exit)",
+                 fontsize=10)
+    _legend_below(figure, ncols=1)
     ax.grid(alpha=0.3)
     return _png(figure)
 
 
 def attitude(mechanism, evaluation, phi):
     figure, ax = _figure()
-    ax.plot(np.degrees(phi), np.degrees(mechanism.attitude(phi)), lw=1.4)
-    for name, angle in _events_deg(evaluation).items():
+    ax.plot(np.degrees(phi), np.degrees(mechanism.attitude(phi)), lw=1.4, color="tab:blue",
+            label="attitude Psi")
+    events = _events_deg(evaluation)
+    for (name, angle), colour in zip(events.items(), ("tab:orange", "tab:green", "tab:red")):
         value = np.degrees(mechanism.attitude(np.array([angle]))[0])
-        ax.plot(np.degrees(angle), value, "o")
-        ax.annotate(f"{name}\n{value:.2f} deg", (np.degrees(angle), value),
-                    textcoords="offset points", xytext=(6, 6), fontsize=8)
+        ax.plot(np.degrees(angle), value, "o", color=colour,
+                label=f"{name}: {value:.2f} deg at phi = {np.degrees(angle):.1f} deg")
+    _event_ticks(ax, {name: np.degrees(angle) for name, angle in events.items()})
+    ax.set_xlim(0, 360)
     ax.set_xlabel("carrier angle phi (deg)")
     ax.set_ylabel("planter attitude Psi (deg, 0 = upright)")
     ax.set_title("Planter attitude")
     ax.grid(alpha=0.3)
+    _legend_below(figure, ncols=2)
     return _png(figure)
 
 
@@ -84,19 +91,21 @@ def velocity(mechanism, evaluation, phi):
         drift = hole.spacing / np.pi * omega
         ax.plot(np.degrees(phi), np.hypot(v[:, 0] + drift, v[:, 1]), lw=1.0,
                 label=f"absolute speed, S = {hole.spacing:g} mm")
-    for name, angle in _events_deg(evaluation).items():
-        ax.axvline(np.degrees(angle), color="0.6", ls=":")
-        ax.text(np.degrees(angle), ax.get_ylim()[1] * 0.95, name, fontsize=8, rotation=90, va="top")
+    events = {name: np.degrees(angle) for name, angle in _events_deg(evaluation).items()}
+    for angle in events.values():
+        ax.axvline(angle, color="0.6", ls=":")
+    _event_ticks(ax, events)
+    ax.set_xlim(0, 360)
     ax.set_xlabel("carrier angle phi (deg)")
     ax.set_ylabel(f"tip speed (mm/s at {evaluation.carrier_speed_rpm:g} r/min)")
-    ax.set_title("Tip speed")
-    ax.legend(fontsize=8)
+    ax.set_title("Tip speed (dotted: soil entry, lowest point, exit)")
+    _legend_below(figure, ncols=2)
     ax.grid(alpha=0.3)
     return _png(figure)
 
 
 def pitch_curves(mechanism, evaluation, samples=1440):
-    figure, ax = _figure(8.0, 5.0)
+    figure, ax = _figure(8.0, 4.4)
     t = np.linspace(0.0, 2 * np.pi, samples + 1)
     a = mechanism.centre_distance
     r1 = mechanism.pitch_curve.radius(t)
@@ -109,8 +118,10 @@ def pitch_curves(mechanism, evaluation, samples=1440):
     ax.plot([0, a], [0, 0], "k+", ms=10)
     ax.plot([r1[0]], [0], "ro", ms=4, label="contact at the catching position")
     ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
     ax.set_title(f"Non-circular pair: a = {a:.4f} mm, module {evaluation.module:.3f} mm")
-    ax.legend(fontsize=8)
+    _legend_below(figure, ncols=3)
     ax.grid(alpha=0.3)
     return _png(figure)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cadgen.report.plots.planting import _figure, _png
+from cadgen.report.plots.base import _figure, _legend_below, _png
 from kinematics.planar import unit as _unit
 
 __all__ = ["pricking_figures"]
@@ -17,17 +17,22 @@ def loop(design):
     u = np.linspace(0.0, curve.period, 1500)
     path = curve(u)
     ax.plot(path[:, 0], path[:, 1], lw=1.6, label=f"tip loop (degree {curve.degree})")
-    ax.plot(curve.points[:, 0], curve.points[:, 1], "ko", ms=4)
+    ax.plot(curve.points[:, 0], curve.points[:, 1], "ko", ms=4, label="type-value points Q")
     for k, point in enumerate(curve.points):
-        ax.annotate(f"Q{k + 1}", point, textcoords="offset points", xytext=(5, 4), fontsize=8)
+        # the label pushed outwards from the loop's centroid, off the curve
+        away = point - path.mean(axis=0)
+        away = 11 * away / max(float(np.hypot(*away)), 1e-9)
+        ax.annotate(f"Q{k + 1}", point, textcoords="offset points", xytext=tuple(away),
+                    ha="center", va="center", fontsize=8,
+                    bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.8})
     angles = np.linspace(-np.pi, np.pi, 720)
-    for radius, style in ((link.l + 2 * link.a, "--"), (link.l - 2 * link.a, ":")):
+    for radius, style, label in ((link.l + 2 * link.a, "--", "reach l + 2a"),
+                                 (link.l - 2 * link.a, ":", "reach l - 2a")):
         ring = centre + radius * _unit(angles)
-        ax.plot(ring[:, 0], ring[:, 1], style, color="0.6", lw=0.8)
-    for u_dead, label in ((link.u_max, "dead centre R max"), (link.u_min, "dead centre R min")):
-        p = curve(u_dead)
-        ax.plot(*p, "r^", ms=8)
-        ax.annotate(label, p, textcoords="offset points", xytext=(6, -12), fontsize=8, color="r")
+        ax.plot(ring[:, 0], ring[:, 1], style, color="0.6", lw=0.8, label=label)
+    for u_dead, marker, label in ((link.u_max, "r^", "dead centre R max"),
+                                  (link.u_min, "rv", "dead centre R min")):
+        ax.plot(*curve(u_dead), marker, ms=8, label=label)
     # the linkage at the lowest point of the loop
     v = np.linspace(0.0, motion.period, 2000, endpoint=False)
     low = v[np.argmin(curve(motion.u(v))[:, 1])]
@@ -46,16 +51,16 @@ def loop(design):
     ax.set_xlim(path[:, 0].min() - 60, path[:, 0].max() + 60)
     ax.set_xlabel("x (mm, forward travel)")
     ax.set_ylabel("y (mm)")
-    ax.set_title(f"Tip loop, a = {link.a:.3f} mm, l = {link.l:.3f} mm, carrier {design.carrier_sense}")
-    ax.legend(fontsize=8, loc="lower right")
+    ax.set_title(f"Tip loop, a = {link.a:.3f} mm, l = {link.l:.3f} mm, carrier "
+                 f"{design.carrier_sense}", fontsize=10)
+    _legend_below(figure, ncols=3)
     ax.grid(alpha=0.3)
     return _png(figure)
 
 
 def pitch_curves(design):
-    import matplotlib.pyplot as plt
-
-    figure, axes = plt.subplots(2, 2, figsize=(9.0, 8.0), dpi=110)
+    # constrained layout keeps each title clear of the tick labels of the plot above
+    figure, axes = _figure(9.0, 8.5, nrows=2, ncols=2)
     for ax, gear in zip(axes.ravel(), design.gears):
         radius, angle = gear.table["radius"], gear.table["body_angle"]
         xy = np.c_[radius * np.cos(angle), radius * np.sin(angle)]
@@ -73,6 +78,7 @@ def pitch_curves(design):
                      f"perimeter {gear.perimeter:.2f} mm, max pressure-angle dev. "
                      f"{gear.pressure_angle_deviation_max_deg:.1f} deg", fontsize=9)
         ax.set_aspect("equal")
+        ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3)
     figure.suptitle(f"Pitch curves: teeth {design.teeth[0]} / {design.teeth[1]}, modules "
                     f"{design.modules[0]:.3f} / {design.modules[1]:.3f} mm, scale {design.scale:.4f}")
@@ -92,7 +98,8 @@ def ratio(design):
     ax.set_xlabel("carrier progress from the outer dead centre (deg)")
     ax.set_ylabel("ratio (planet relative to carrier)")
     ax.set_title("Transmission ratios along the loop")
-    ax.legend(fontsize=8)
+    ax.set_xlim(progress.min(), progress.max())
+    _legend_below(figure, ncols=2)
     ax.grid(alpha=0.3)
     return _png(figure)
 
@@ -100,7 +107,7 @@ def ratio(design):
 def field_paths(design, field, params):
     from kinematics.pricking_field import _FieldModel
 
-    figure, ax = _figure(9.0, 5.0)
+    figure, ax = _figure(9.0, 4.6)
     model = _FieldModel(design, params.field.carrier_speed_rpm, params.field.forward_speed)
     v = np.linspace(0.0, 2 * design.motion.period, 3000)
     x = model.absolute_x(v)
@@ -125,7 +132,8 @@ def field_paths(design, field, params):
     ax.set_title("Absolute needle-tip paths and needle postures at entry and exit\n"
                  "per inclination (dotted: soil surface)", fontsize=10)
     ax.set_aspect("equal")
-    ax.legend(fontsize=7, loc="upper center")
+    ax.margins(x=0.02, y=0.1)   # room above the needles' roots
+    _legend_below(figure, ncols=1)
     ax.grid(alpha=0.3)
     return _png(figure)
 

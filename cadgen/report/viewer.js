@@ -1,0 +1,116 @@
+// cadgen report: the 3D view of assembly.glb, embedded in the page (base64), drawn with the
+// vendored three.js bundle (window.CadgenThree; cadgen/report/vendor/). Nothing is fetched.
+(function () {
+  "use strict";
+  var root = document.getElementById("cadgen-viewer");
+  if (!root) return;
+  var message = root.querySelector(".viewer-message");
+  var state = window.cadgenViewer = {state: "loading", meshes: 0, renders: 0};
+
+  function fail(kind, text) {
+    state.state = kind;
+    root.setAttribute("data-state", kind);
+    message.textContent = text;
+    message.hidden = false;
+  }
+
+  var T = window.CadgenThree;
+  if (!T) { fail("error", "The 3D viewer's script did not load."); return; }
+  var canvas = root.querySelector("canvas");
+  var renderer;
+  try {
+    renderer = new T.WebGLRenderer({canvas: canvas, antialias: true, preserveDrawingBuffer: true});
+  } catch (error) {
+    fail("no-webgl", "This browser cannot draw WebGL, so the 3D view is off; the assembly is " +
+         "in solids/assembly.glb beside this report.");
+    return;
+  }
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+  var scene = new T.Scene();
+  scene.background = new T.Color(0xf4f5f7);
+  var camera = new T.PerspectiveCamera(35, 1, 0.001, 100);
+  scene.add(new T.HemisphereLight(0xffffff, 0x8d8577, 1.6));
+  var sun = new T.DirectionalLight(0xffffff, 1.8);
+  sun.position.set(1, 2, 3);
+  scene.add(sun);
+  var controls = new T.OrbitControls(camera, canvas);
+  var home = null;
+
+  function render() {
+    renderer.render(scene, camera);
+    state.renders += 1;
+  }
+  function resize() {
+    var width = Math.max(1, root.clientWidth), height = Math.max(1, canvas.clientHeight);
+    renderer.setSize(width, height, false);
+    camera.aspect = width / height;
+    camera.updateProjectionMatrix();
+    render();
+  }
+  function goHome() {
+    if (!home) return;
+    camera.position.copy(home.position);
+    controls.target.copy(home.target);
+    controls.update();
+    render();
+  }
+
+  // A colour per kind of part, from its node name (the GLB carries no materials).
+  var KINDS = [
+    [/^ground/, {color: 0x9b7653, opacity: 0.35}],
+    [/^(gearbox|gear-case)/, {color: 0xaab4c0, opacity: 0.3}],
+    [/^(blade|planter)/, {color: 0xe08a2c}],
+    [/^cam/, {color: 0x6d8f3c}],
+    [/^needle/, {color: 0x3a3f47}],
+    [/^rocker/, {color: 0x3c7fb0}],
+    [/./, {color: 0x7f93aa, metalness: 0.35}]
+  ];
+  function material(name) {
+    for (var i = 0; i < KINDS.length; i++) {
+      if (KINDS[i][0].test(name)) {
+        var k = KINDS[i][1];
+        return new T.MeshStandardMaterial({
+          color: k.color, metalness: k.metalness || 0.1, roughness: 0.6, side: T.DoubleSide,
+          transparent: k.opacity !== undefined, opacity: k.opacity === undefined ? 1 : k.opacity,
+          depthWrite: k.opacity === undefined});
+      }
+    }
+  }
+
+  var text = document.getElementById("cadgen-glb").textContent.replace(/\s+/g, "");
+  var binary = atob(text), bytes = new Uint8Array(binary.length);
+  for (var i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
+  new T.GLTFLoader().parse(bytes.buffer, "", function (gltf) {
+    var model = gltf.scene;
+    model.scale.setScalar(0.001);   // the GLB is in millimetres; glTF (and this view) in metres
+    var fit = new T.Box3();
+    model.updateMatrixWorld(true);
+    model.traverse(function (node) {
+      if (!node.isMesh) return;
+      var name = node.name || (node.parent && node.parent.name) || "";
+      node.material = material(name);
+      state.meshes += 1;
+      if (!/^ground/.test(name)) fit.expandByObject(node);   // the soil slab is wide: not framed
+    });
+    if (fit.isEmpty()) fit.setFromObject(model);
+    scene.add(model);
+    var centre = fit.getCenter(new T.Vector3()), size = fit.getSize(new T.Vector3());
+    var distance = 0.55 * size.length() / Math.sin(Math.PI * 35 / 360);   // the bounding sphere
+    // front view (x forward to the right, y up), turned a little to show the axial stack
+    var direction = new T.Vector3(0.45, 0.25, 1).normalize();
+    home = {position: centre.clone().addScaledVector(direction, distance), target: centre.clone()};
+    camera.near = distance / 100;
+    camera.far = distance * 20;
+    controls.addEventListener("change", render);
+    goHome();
+    resize();
+    state.state = "ready";
+    root.setAttribute("data-state", "ready");
+  }, function (error) {
+    fail("error", "The embedded assembly could not be read: " + error);
+  });
+
+  root.querySelector(".viewer-home").addEventListener("click", goHome);
+  if (window.ResizeObserver) new ResizeObserver(resize).observe(root);
+  window.addEventListener("beforeprint", render);
+})();

@@ -1,0 +1,79 @@
+"""The report's interactive 3D view of ``solids/assembly.glb``, working offline from the one page.
+
+The GLB is embedded as base64 and drawn by a vendored build of three.js
+(``vendor/three-viewer.min.js``: WebGLRenderer, GLTFLoader, OrbitControls; its
+version and how it was built are in ``vendor/README.md``), inlined with a small
+script of ours (``viewer.js``): the page fetches nothing, so it works from an
+e-mail attachment or an offline laptop. The GLB is in millimetres; the viewer
+scales it to glTF's metres.
+
+:func:`interactive_sections` is what the page calls: the animation section
+(:mod:`cadgen.report.animation`), then this 3D view, with their shared style.
+"""
+
+from __future__ import annotations
+
+import base64
+import functools
+import html
+import importlib.resources
+
+from cadgen.report.animation import animation_section
+
+__all__ = ["THREE_VERSION", "viewer_section", "interactive_sections"]
+
+#: The vendored three.js release (npm ``three``), see ``vendor/README.md``.
+THREE_VERSION = "0.187.0"
+
+_GLB_MAGIC = b"glTF"
+
+
+@functools.cache
+def _resource(name: str) -> str:
+    return importlib.resources.files("cadgen.report").joinpath(name).read_text(encoding="utf-8")
+
+
+def viewer_section(glb: bytes | None) -> str:
+    """The 3D view section (``""`` without a GLB): a canvas, the embedded GLB, the scripts.
+
+    Parameters
+    ----------
+    glb : bytes or None
+        The assembly as binary glTF (``solids/assembly.glb``), in millimetres.
+
+    Raises
+    ------
+    ValueError
+        If ``glb`` is not binary glTF.
+    """
+    if glb is None:
+        return ""
+    glb = bytes(glb)
+    if not glb.startswith(_GLB_MAGIC):
+        raise ValueError(f"assembly must be binary glTF (starting b'glTF'), not {glb[:4]!r}")
+    encoded = base64.b64encode(glb).decode("ascii")
+    size = f"{len(glb) / 1e6:.2f} MB" if len(glb) >= 1e5 else f"{len(glb) / 1e3:.0f} kB"
+    vendor = _resource("vendor/three-viewer.min.js").replace("</script", "<\\/script")
+    return (
+        '<section id="view-3d"><h2>3D view of the assembly</h2>'
+        f'<p class="note">{html.escape("solids/assembly.glb")} ({size}), embedded: drag to turn, '
+        "scroll to zoom, right-drag to pan. Housings and soil are drawn see-through. Drawn with "
+        f"three.js {THREE_VERSION} (MIT), inlined: nothing is fetched.</p>"
+        '<div class="viewer" id="cadgen-viewer" data-state="loading">'
+        '<canvas aria-label="3D view of the assembly"></canvas>'
+        '<p class="viewer-message" hidden></p>'
+        '<button type="button" class="viewer-home">Reset view</button></div>'
+        f'<script type="application/octet-stream" id="cadgen-glb">{encoded}</script>'
+        f"<script>{vendor}</script><script>{_resource('viewer.js')}</script></section>")
+
+
+def interactive_sections(animation: dict | None = None, glb: bytes | None = None) -> list[str]:
+    """The page's moving sections: the animation, then the 3D view, each only when given.
+
+    The style they share comes once, inside the first of them.
+    """
+    sections = [s for s in (animation_section(animation), viewer_section(glb)) if s]
+    if sections:
+        head, rest = sections[0].split("</h2>", 1)
+        sections[0] = f"{head}</h2><style>{_resource('interactive.css')}</style>{rest}"
+    return sections
