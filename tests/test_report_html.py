@@ -340,9 +340,10 @@ def test_report_failures_decide_the_verdict(planting):
     table = rows(section(page, "metrics"))
     assert table[0][-1] == "kinematic estimate"
     assert table[1][-1] == "99.500 mm" and table[2][-1] == ""
-    # Reports that list failures count pricking findings among them.
+    # An undercut finding is a prediction for rack cutting: a warning whether or not the
+    # report has failures (the cut teeth decide; see test_verdict_policy.py)
     pricking = render_html(dict(PRICKING, failures=["[undercut] ..."], passed=False), {})
-    assert "FAIL</span> <code>[undercut]</code>" in section(pricking, "field")
+    assert "WARN</span> <code>[undercut]</code>" in section(pricking, "field")
     assert "WARN</span> <code>[undercut]</code>" in section(render_html(PRICKING, {}), "field")
 
 
@@ -521,7 +522,8 @@ def test_preset_is_a_table_of_knobs_with_their_origin(planting):
     parse(page)
     assert "{'" not in page and "&#x27;value&#x27;" not in page and "{&#x27;" not in page
     header = re.search(r"<header>(.*?)</header>", page, re.S)[1]
-    preset = re.search(r'<div class="preset">(.*?)</div>(<table>.*?</table>)', header, re.S)
+    preset = re.search(r'<div class="preset">(.*?)</div><div class="wide">(<table>.*?</table>)',
+                       header, re.S)
     table = rows(preset[2])
     assert table[0] == ["knob", "value", "from"]
     written = tomllib.loads(REFERENCE.read_text(encoding="utf-8"))
@@ -562,3 +564,17 @@ def test_an_undecided_metric_and_the_warnings_are_shown(planting):
     assert "push_rod_inverted" in page and "stage cam, not run in this build" in page
     assert "1 warning (stages not run)" in page
     assert "Warnings" not in render_html(planting, {})
+
+
+def test_a_predicted_undercut_finding_warns_and_a_concave_one_fails():
+    # kernel-a: concave pitch curves fail the design; the rack-undercut prediction only warns
+    import json
+
+    report = {"design": "k", "mechanism": "pricking", "failures": ["x"], "findings": [
+        {"path": "gears.sun", "code": "concave_pitch_curve", "message": "concave"},
+        {"path": "gears.sun", "code": "undercut", "message": "predicted undercut"}]}
+    page = render_html(json.loads(json.dumps(report)), {})
+    items = re.findall(r"<li>(.*?)</li>", page, re.S)
+    concave = next(i for i in items if "concave_pitch_curve" in i)
+    undercut = next(i for i in items if "[undercut]" in i)
+    assert ">FAIL<" in concave and ">WARN<" in undercut and ">FAIL<" not in undercut

@@ -160,11 +160,17 @@ def _pricking_section(report: dict) -> str:
     body = [note, _table(["inclination", "needle entry", "needle exit", "hole mouth", "in soil",
                           "slow windows (from R max)", "slow total", "height", "width", "needle root in soil"],
                          rows, numeric=(0, 1, 2, 3, 4, 6, 7, 8), row_classes=classes)]
+    from cadgen.report.content import PREDICTED_FINDINGS
+
     findings = report.get("findings", [])
-    # Newer reports count findings among their failures; older ones only warn.
+    # Newer reports count findings among their failures, but a prediction for rack cutting
+    # (undercut) only warns: the cut teeth decide. Older reports only warn.
     state = "fail" if "failures" in report else "warn"
+    failing = [f for f in findings if f.get("code") not in PREDICTED_FINDINGS]
+    predicted = [f for f in findings if f.get("code") in PREDICTED_FINDINGS]
     body.append(f"<h3>Findings ({len(findings)})</h3>"
-                + (_problem_list(findings, state) or '<p class="note">none</p>'))
+                + ((_problem_list(failing, state) + _problem_list(predicted, "warn"))
+                   or '<p class="note">none</p>'))
     gears = report.get("gears", {})
     if gears.get("pitch_curves"):
         rows = [[_e(g["name"]), _e(str(g["stage"])), _e(g["role"]),
