@@ -15,7 +15,9 @@ shapely = pytest.importorskip("shapely")
 
 import cadgen.export.atomic
 import cadgen.export.dxf as export_dxf
-from cadgen.export.dxf import DxfExportError, DxfInputError, DxfSummary, write_gear_dxf, write_train_sheet
+from cadgen.export.dxf import (CENTRE_LAYER, CUTTING_LAYERS, LABEL_LAYER, PITCH_CURVE_GAP, PITCH_LAYER,
+                               DxfExportError, DxfInputError, DxfSummary, write_cam_dxf, write_gear_dxf)
+from cadgen.export.train_sheet import write_train_sheet
 from cadgen.gears.teeth import GearProfile
 from kinematics.errors import MechanismError
 
@@ -95,6 +97,33 @@ def _written_outline(path):
     return np.array(polyline.get_points(format="xy"), dtype=float)
 
 
+def _text_box(text):
+    """The box the writer counts for a TOP_CENTER TEXT: 0.8 heights a character, 1.5 heights deep."""
+    x, y = _xy(text.dxf.align_point)
+    height, half = text.dxf.height, 0.4 * len(text.dxf.text) * text.dxf.height
+    return np.array([[x - half, y - 1.5 * height], [x + half, y]])
+
+
+def _extents(doc):
+    """Bounding box of every entity, computed here from the entities' own numbers."""
+    corners = []
+    for entity in doc.modelspace():
+        kind = entity.dxftype()
+        if kind == "LWPOLYLINE":
+            corners.append(np.array(entity.get_points(format="xy"), dtype=float))
+        elif kind == "CIRCLE":
+            centre, radius = _xy(entity.dxf.center), entity.dxf.radius
+            corners.append(np.array([centre - radius, centre + radius]))
+        elif kind == "LINE":
+            corners.append(np.array([_xy(entity.dxf.start), _xy(entity.dxf.end)]))
+        elif kind == "TEXT":
+            corners.append(_text_box(entity))
+        else:
+            raise AssertionError(f"unexpected entity {kind}")
+    corners = np.vstack(corners)
+    return corners.min(axis=0), corners.max(axis=0)
+
+
 def _area_perimeter(points):
     ring = shapely.LinearRing(points)
     return shapely.Polygon(ring).area, ring.length
@@ -120,8 +149,8 @@ def test_round_trip_layers_entities_units(tmp_path, name, star, bay):
         assert doc.layers.get(layer).dxf.color == colour
 
     (outline,) = _entities(doc, "OUTLINE", "LWPOLYLINE")
-    (pitch,) = _entities(doc, "PITCH", "LWPOLYLINE")
-    assert outline.closed and pitch.closed
+    (pitch,) = _entities(doc, PITCH_LAYER, "LWPOLYLINE")
+    assert outline.closed and not pitch.closed  # construction: an open curve, never a cutting loop
     points = np.array(outline.get_points(format="xy"))
     assert len(points) == summary.outline_points_written
     assert not np.array_equal(points[0], points[-1])  # closed by the flag, not by a repeated point
@@ -134,7 +163,7 @@ def test_round_trip_layers_entities_units(tmp_path, name, star, bay):
     assert bore.dxf.radius == pytest.approx(profile.bore_radius)
     assert np.allclose(_xy(bore.dxf.center), profile.centre)
 
-    lines = _entities(doc, "CENTRE", "LINE")
+    lines = _entities(doc, CENTRE_LAYER, "LINE")
     assert len(lines) == 2
     directions = []
     for line in lines:
@@ -357,11 +386,13 @@ def test_train_sheet_two_gears(tmp_path, star, bay):
     assert not doc.audit().has_errors
     assert doc.units == ezdxf.units.MM
     outlines = _entities(doc, "OUTLINE", "LWPOLYLINE")
-    pitches = _entities(doc, "PITCH", "LWPOLYLINE")
-    labels = _entities(doc, "LABELS", "TEXT")
+    pitches = _entities(doc, PITCH_LAYER, "LWPOLYLINE")
+    texts = _entities(doc, LABEL_LAYER, "TEXT")
+    labels, titles = texts[:-1], texts[-1:]  # two centres: one view, one title
     assert len(outlines) == 2 and len(pitches) == 2 and len(labels) == 2
-    assert len(_entities(doc, "BORE", "CIRCLE")) == 2 and len(_entities(doc, "CENTRE", "LINE")) == 4
-    assert all(polyline.closed for polyline in outlines + pitches)
+    assert [title.dxf.text for title in titles] == ["gear plane 1 of 1"]
+    assert len(_entities(doc, "BORE", "CIRCLE")) == 2 and len(_entities(doc, CENTRE_LAYER, "LINE")) == 4
+    assert all(polyline.closed for polyline in outlines) and not any(p.closed for p in pitches)
     assert [label.dxf.text for label in labels] == ["star gear", "bay part"]
 
     for (profile, angle, offset), polyline, label, summary in zip(placements, outlines, labels, summaries):
@@ -377,10 +408,12 @@ def test_train_sheet_two_gears(tmp_path, star, bay):
         # The pose is the one asked for: every dense placed point within the tolerance of the written one.
         distances = shapely.distance(shapely.points(dense_placed), shapely.LinearRing(written))
         assert distances.max() <= summary.chord_tolerance_used + ACCURACY
-        # Label centred under its gear.
+        # Label centred under its gear's centre: inside the gear, clear of its bore.
         anchor = _xy(label.dxf.align_point)
         assert anchor[0] == pytest.approx(offset[0])
-        assert anchor[1] < written[:, 1].min()
+        box = shapely.box(*_text_box(label).ravel())
+        assert shapely.Polygon(written).contains(box)
+        assert box.distance(shapely.Point(offset)) > profile.bore_radius
 
 
 def test_train_sheet_bad_placements(tmp_path, star):
@@ -394,6 +427,174 @@ def test_train_sheet_bad_placements(tmp_path, star):
     assert "placements[1]" in text and "offset" in text and "inf" in text
     assert "placements[2]" in text
     assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- what CAM programs see
+
+PLANTING_FILES = ["central", "intermediate", "gear-D", "planet-gear-E", "sun", "idler-1", "idler-2",
+                  "train-1-planet", "train", "cam"]
+
+
+@pytest.fixture(scope="module")
+def planting_dxf(tmp_path_factory):
+    """The DXF files a build of the paper's planter writes: name -> path."""
+    from tests.helpers import REFERENCE
+
+    folder = tmp_path_factory.mktemp("planter")
+    run = subprocess.run([sys.executable, "-m", "cadgen", "build", str(REFERENCE), "--output-dir",
+                          str(folder), "--effects", "dxf"], capture_output=True, text=True)
+    assert run.returncode in (0, 1), run.stderr
+    found = {path.stem: path for path in folder.rglob("*.dxf")}
+    assert sorted(found) == sorted(PLANTING_FILES)
+    return found
+
+
+def _closes(entity) -> bool:
+    """Whether a CAM program taking closed paths would take this entity as one."""
+    if entity.dxftype() == "CIRCLE":
+        return True
+    if entity.dxftype() == "LWPOLYLINE":
+        points = np.array(entity.get_points(format="xy"))
+        return entity.closed or np.linalg.norm(points[0] - points[-1]) < PITCH_CURVE_GAP
+    return False
+
+
+@pytest.mark.parametrize("name", PLANTING_FILES, ids=PLANTING_FILES)
+def test_only_cutting_layers_hold_closed_paths_and_only_they_plot(planting_dxf, name):
+    doc = ezdxf.readfile(planting_dxf[name])
+    for layer in doc.layers:
+        if layer.dxf.name in ("0", "Defpoints"):
+            continue
+        if layer.dxf.name in CUTTING_LAYERS:
+            assert layer.dxf.plot == 1, layer.dxf.name
+        elif name == "train" and layer.dxf.name == LABEL_LAYER:
+            # the train sheet is for people: its labels print (text only, never a path)
+            assert layer.dxf.plot == 1
+            assert {e.dxftype() for e in doc.modelspace() if e.dxf.layer == LABEL_LAYER} == {"TEXT"}
+        else:  # construction: named so, and off paper
+            assert layer.dxf.name.startswith("CONSTRUCTION-") and layer.dxf.plot == 0, layer.dxf.name
+    entities = list(doc.modelspace())
+    assert {entity.dxf.layer for entity in entities} <= set(export_dxf.LAYERS)
+    closed = [entity for entity in entities if _closes(entity)]
+    assert closed and all(entity.dxf.layer in CUTTING_LAYERS for entity in closed)
+    assert all(_closes(entity) for entity in entities if entity.dxf.layer in CUTTING_LAYERS)
+    # every pitch curve is there, open, its ends a gap apart
+    gears = len(_entities(doc, "OUTLINE", "LWPOLYLINE"))
+    assert len([e for e in entities if e.dxf.layer == PITCH_LAYER and not e.closed]) == gears
+
+
+@pytest.mark.parametrize("name", PLANTING_FILES, ids=PLANTING_FILES)
+def test_header_extents_are_the_drawings_bounding_box(planting_dxf, name):
+    doc = ezdxf.readfile(planting_dxf[name])
+    low, high = _extents(doc)
+    assert np.allclose(np.array(doc.header["$EXTMIN"][:2]), low, rtol=0, atol=1e-6)
+    assert np.allclose(np.array(doc.header["$EXTMAX"][:2]), high, rtol=0, atol=1e-6)
+    assert np.allclose(doc.header["$LIMMIN"], low, rtol=0, atol=1e-6)
+    assert np.allclose(doc.header["$LIMMAX"], high, rtol=0, atol=1e-6)
+    assert doc.header["$INSUNITS"] == 4  # millimetres
+
+
+def _views(doc):
+    """[(title, gear names)] left to right: each label goes to the title nearest it along x."""
+    texts = _entities(doc, LABEL_LAYER, "TEXT")
+    titles = sorted((text for text in texts if text.dxf.text.startswith("gear plane")),
+                    key=lambda title: title.dxf.align_point.x)
+    views = {title.dxf.text: set() for title in titles}
+    for label in texts:
+        if label not in titles:
+            nearest = min(titles, key=lambda title: abs(title.dxf.align_point.x - label.dxf.align_point.x))
+            views[nearest.dxf.text].add(label.dxf.text)
+    return list(views.items())
+
+
+def _shift(title) -> float:
+    """The shift a view's title names (mm along x; 0 for the first view)."""
+    import re
+
+    found = re.fullmatch(r"gear plane \d+ of \d+(?: \(x \+ (\d+) mm\))?", title)
+    assert found, title
+    return float(found.group(1) or 0.0)
+
+
+def test_train_sheet_draws_each_gear_plane_apart(planting_dxf):
+    doc = ezdxf.readfile(planting_dxf["train"])
+    views = _views(doc)
+    assert [names for _, names in views] == [{"central", "intermediate"}, {"gear D", "planet gear E"},
+                                             {"sun", "idler 1", "idler 2", "train-1 planet"}]
+    assert [title.split(" (")[0] for title, _ in views] == [f"gear plane {k} of 3" for k in (1, 2, 3)]
+    shifts = [_shift(title) for title, _ in views]
+    assert shifts[0] == 0 and all(s % 10 == 0 for s in shifts) and shifts == sorted(set(shifts))
+    outlines = [shapely.Polygon(e.get_points(format="xy")) for e in _entities(doc, "OUTLINE", "LWPOLYLINE")]
+    assert len(outlines) == 8
+    # gears meshing touch at most by the meshing check's overlap; gears on one shaft would cover
+    # each other by thousands of mm^2
+    for first, second in zip(*np.triu_indices(len(outlines), 1)):
+        assert outlines[first].intersection(outlines[second]).area < 0.01
+    # every shaft (6 of them) marked once in each of the 3 views: no two marks at one place
+    crossings = {tuple(np.round((_xy(line.dxf.start) + _xy(line.dxf.end)) / 2, 6))
+                 for line in _entities(doc, CENTRE_LAYER, "LINE")}
+    assert len(crossings) == 3 * 6 == len(_entities(doc, CENTRE_LAYER, "LINE")) / 2
+    # the labels sit inside their gears, clear of every other outline
+    for label in _entities(doc, LABEL_LAYER, "TEXT"):
+        box = shapely.box(*_text_box(label).ravel())
+        assert sum(outline.contains(box) for outline in outlines) <= 1
+        assert not any(outline.exterior.intersects(box) for outline in outlines)
+
+
+@pytest.mark.parametrize("name", ["train", "central", "cam"], ids=["train", "gear", "cam"])
+def test_labels_print_black_and_construction_is_not_yellow(planting_dxf, name):
+    doc = ezdxf.readfile(planting_dxf[name])
+    for text in doc.modelspace().query("TEXT"):
+        colour = text.dxf.color if text.dxf.color != 256 else doc.layers.get(text.dxf.layer).dxf.color
+        assert colour == 7 or 250 <= colour <= 255, (text.dxf.text, colour)
+    assert all(layer.dxf.color != 2 for layer in doc.layers)  # no yellow: unreadable on paper
+
+
+def test_gears_on_one_shaft_go_to_different_views(tmp_path, star, bay):
+    placements = [(star, 0.0, (0.0, 0.0)), (bay, 0.5, (0.0, 0.0))]
+    write_train_sheet(tmp_path / "a.dxf", placements)
+    doc = ezdxf.readfile(tmp_path / "a.dxf")
+    first, second = [shapely.Polygon(e.get_points(format="xy")) for e in _entities(doc, "OUTLINE", "LWPOLYLINE")]
+    assert not first.intersects(second)
+    (title, names), (second_title, second_names) = _views(doc)
+    assert (title, names, second_names) == ("gear plane 1 of 2", {"star gear"}, {"bay part"})
+    shift = _shift(second_title)
+    assert shift >= 60.0 + 30.0  # the two gears (radius 32, 30) apart, with a gap
+    assert np.allclose(first.centroid.coords[0], [0.0, 0.0], atol=1e-3)
+    placed, _ = bay.placed(0.5, (shift, 0.0))  # its pose, moved along x only
+    assert second.centroid.distance(shapely.Polygon(placed).centroid) < 0.01
+    low, high = _extents(doc)
+    assert np.allclose(np.array(doc.header["$EXTMIN"][:2]), low, atol=1e-6)
+    assert np.allclose(np.array(doc.header["$EXTMAX"][:2]), high, atol=1e-6)
+    # the same input gives the same bytes
+    write_train_sheet(tmp_path / "b.dxf", placements)
+    assert (tmp_path / "a.dxf").read_bytes() == (tmp_path / "b.dxf").read_bytes()
+    # planes asked for: one shaft in one plane is refused, naming both gears
+    with pytest.raises(DxfInputError, match="share a shaft.*different planes") as caught:
+        write_train_sheet(tmp_path / "c.dxf", placements, planes=[0, 0])
+    assert "'star gear'" in str(caught.value) and "'bay part'" in str(caught.value)
+    with pytest.raises(DxfInputError, match=r"planes\[1\] must be an integer >= 0, got -1"):
+        write_train_sheet(tmp_path / "c.dxf", placements, planes=[0, -1])
+    with pytest.raises(DxfInputError, match="one plane per placement"):
+        write_train_sheet(tmp_path / "c.dxf", placements, planes=[0])
+    assert not (tmp_path / "c.dxf").exists()
+
+
+def test_cam_pitch_curve_is_open_construction(tmp_path):
+    t = np.linspace(0.0, 2.0 * np.pi, 3600, endpoint=False)
+    contour = np.column_stack([(40 + 5 * np.cos(t)) * np.cos(t), (40 + 5 * np.cos(t)) * np.sin(t)])
+    pitch = np.column_stack([(48 + 5 * np.cos(t)) * np.cos(t), (48 + 5 * np.cos(t)) * np.sin(t)])
+    write_cam_dxf(tmp_path / "cam.dxf", contour, pitch, bore_radius=6.0)
+    doc = ezdxf.readfile(tmp_path / "cam.dxf")
+    (curve,) = _entities(doc, PITCH_LAYER, "LWPOLYLINE")
+    points = np.array(curve.get_points(format="xy"))
+    assert not curve.closed and np.linalg.norm(points[0] - points[-1]) >= PITCH_CURVE_GAP
+    # the rest of the roller path is all there: the left-out stretch is short
+    assert shapely.LineString(points).length > shapely.LinearRing(pitch).length - 3 * PITCH_CURVE_GAP
+    low, high = _extents(doc)
+    assert np.allclose(np.array(doc.header["$EXTMIN"][:2]), low, atol=1e-6)
+    assert np.allclose(np.array(doc.header["$EXTMAX"][:2]), high, atol=1e-6)
+    assert np.allclose(high, pitch.max(axis=0), atol=0.01)  # the pitch curve, the largest
 
 
 # --------------------------------------------------------------------------- import weight

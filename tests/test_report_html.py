@@ -578,3 +578,22 @@ def test_a_predicted_undercut_finding_warns_and_a_concave_one_fails():
     concave = next(i for i in items if "concave_pitch_curve" in i)
     undercut = next(i for i in items if "[undercut]" in i)
     assert ">FAIL<" in concave and ">WARN<" in undercut and ">FAIL<" not in undercut
+
+
+def test_parts_larger_than_the_build_volume_are_listed(planting):
+    from cadgen.report.summary import format_solids
+
+    report = copy.deepcopy(planting)
+    report["solids"] = {"parts": [], "total_mass_kg": 1.0, "density_kg_m3": 7850.0,
+                        "assembly": {"file": "solids/assembly.glb", "carrier_angle_deg": 0.0},
+                        "enclosure": []}
+    report["solids"]["build_volume_mm"] = [256.0, 256.0, 256.0]
+    report["solids"]["too_big_for_build_volume"] = [
+        {"part": "gearbox1", "kind": "housing", "print_extents_mm": [100.0, 560.8, 21.0]}]
+    body = section(render_html(report, {}), "solids")
+    assert "Parts larger than the build volume (256 x 256 x 256 mm)" in body
+    (row,) = [r for r in rows(body) if r and r[0] == "gearbox1" and len(r) == 4]
+    assert row[2] == "100.0 x 560.8 x 21.0" and row[3] == "TOO BIG"
+    text = format_solids(report["solids"])
+    assert "warning: gearbox1 (housing) is 100.0 x 560.8 x 21.0 mm" in text
+    assert "256 x 256 x 256 mm (solids.build_volume)" in text

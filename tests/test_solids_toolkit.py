@@ -479,7 +479,9 @@ def test_glb_round_trip_and_determinism(parts):
     scene = trimesh.load_scene(trimesh.util.wrap_as_stream(data), file_type="glb")
     assert sorted(scene.graph.nodes_geometry) == sorted(name for name, _, _ in parts)
     moved = scene.graph["gear b"][0]
-    assert moved == pytest.approx(parts[2][2], abs=1e-12)
+    in_metres = parts[2][2].copy()
+    in_metres[:3, 3] *= 1e-3          # glTF's unit is the metre: the placement is too
+    assert moved == pytest.approx(in_metres, abs=1e-12)
 
 
 def test_three_mf_is_deterministic_and_round_trips(parts):

@@ -1,34 +1,30 @@
 """DXF export of generated gears (one cutting file per gear, an assembled train sheet) and cams.
 
-Each gear file holds, in millimetres and on layers of their own:
+Layers, in millimetres. Only the two *cutting* layers hold cutting paths, and they are plotted;
+everything else is construction geometry on ``CONSTRUCTION-...`` layers whose plot flag is off
+(a CAM program filtering by layer takes ``OUTLINE`` and ``BORE`` only):
 
-``OUTLINE``
-    The tooth outline as one closed ``LWPOLYLINE`` (the cutting path).
-``BORE``
-    The shaft bore as a ``CIRCLE`` at the rotation centre (only if the bore radius is > 0).
-``PITCH``
-    The pitch curve as one closed ``LWPOLYLINE`` (reference geometry).
-``CENTRE``
-    A centre mark: two ``LINE`` entities, each two modules long, crossing at the centre.
+``OUTLINE`` (colour 7)
+    The tooth outline (cam: the working profile), one closed ``LWPOLYLINE``.
+``BORE`` (colour 1)
+    The shaft bore, a ``CIRCLE`` at the rotation centre (if the bore radius is > 0).
+``CONSTRUCTION-PITCH`` (colour 3, centre line)
+    The pitch curve (cam: the roller centre's path), one *open* ``LWPOLYLINE``: its closing
+    stretch (at least :data:`PITCH_CURVE_GAP`) is left out, so chaining never closes it.
+``CONSTRUCTION-CENTRE`` (colour 4, centre line)
+    Centre marks: two ``LINE`` entities, each two modules long, crossing at the centre.
+``CONSTRUCTION-LABELS`` (colour 7, black on paper; printed on the train sheet, which is for people)
+    Train sheet only: a ``TEXT`` per gear and a title per view.
 
-The train sheet (:func:`write_train_sheet`) places several gears at given poses
-on one drawing, with a ``TEXT`` label per gear on ``LABELS``. A plate cam
-(:func:`write_cam_dxf`) is laid out like a gear: its working profile on
-``OUTLINE``, the roller centre's path on ``PITCH``, bore and centre mark.
+The train sheet (:func:`write_train_sheet`) draws one view per gear plane, side by side along
+x, so gears sharing a shaft are never drawn on top of each other; every shaft is marked in
+every view. The header extents (``$EXTMIN``/``$EXTMAX``, ``$LIMMIN``/``$LIMMAX``) are the
+bounding box of the entities (``ezdxf.bbox``; a ``TEXT`` as :func:`_text_box`, font-free).
 
-The dense outline of the generator (thousands of points) is thinned by
-Douglas-Peucker with a chord tolerance: every dropped point lies within the
-tolerance of the written polyline. If thinning would make the ring cross itself
-(or cut into the bore), the tolerance is halved until it does not; the tolerance
-actually used is reported in :class:`DxfSummary`.
-
-Every document passes ``ezdxf``'s audit before it is written, and files are written
-atomically (:func:`cadgen.export.atomic.write_bytes_atomic`): a failure leaves either the
-previous file or none, never a partial one. The same input gives byte-identical
-files (fixed creation metadata).
-
-``ezdxf`` and ``shapely`` are imported inside the functions, so importing this
-module (and ``cadgen --help``) stays light.
+The dense outline is thinned by Douglas-Peucker to a chord tolerance (halved until the ring
+stays simple and clear of the bore; the tolerance used is in :class:`DxfSummary`). Every
+document passes ``ezdxf``'s audit and is written atomically and byte-identically for the same
+input (fixed metadata). ``ezdxf`` and ``shapely`` are imported inside the functions.
 """
 
 from __future__ import annotations
@@ -44,8 +40,8 @@ from pathlib import Path
 import numpy as np
 
 from cadgen.export.atomic import write_bytes_atomic
-from cadgen.geometry.contour import (closed_points, ring_measures, ring_problems, thin_outline,
-                                     thin_ring)
+from cadgen.geometry.contour import (closed_points, open_ring, ring_measures, ring_problems,
+                                     thin_outline, thin_ring)
 from kinematics.errors import MechanismError
 
 __all__ = [
@@ -53,22 +49,20 @@ __all__ = [
     "DxfInputError",
     "DxfSummary",
     "LAYERS",
+    "CUTTING_LAYERS",
+    "CONSTRUCTION_LAYERS",
     "write_gear_dxf",
-    "write_train_sheet",
     "write_cam_dxf",
-    "write_train_files",
 ]
 
-#: Layer name -> AutoCAD colour index (7 = white/black, 1 red, 3 green, 4 cyan, 2 yellow).
-LAYERS = {
-    "OUTLINE": 7,
-    "BORE": 1,
-    "PITCH": 3,
-    "CENTRE": 4,
-    "LABELS": 2,
-}
+PITCH_LAYER, CENTRE_LAYER, LABEL_LAYER = "CONSTRUCTION-PITCH", "CONSTRUCTION-CENTRE", "CONSTRUCTION-LABELS"
+#: Layer name -> AutoCAD colour index (7 black on paper, 1 red, 3 green, 4 cyan): cutting layers
+#: (plotted) and construction layers (plot flag off).
+CUTTING_LAYERS = {"OUTLINE": 7, "BORE": 1}
+CONSTRUCTION_LAYERS = {PITCH_LAYER: 3, CENTRE_LAYER: 4, LABEL_LAYER: 7}
+LAYERS = {**CUTTING_LAYERS, **CONSTRUCTION_LAYERS}
 #: Layers drawn with the centre-line linetype (reference geometry, not cut).
-_CENTRE_LINE_LAYERS = ("PITCH", "CENTRE")
+_CENTRE_LINE_LAYERS = (PITCH_LAYER, CENTRE_LAYER)
 _CENTRE_LINETYPE = "CENTER"
 #: Dash pattern of the centre line in mm: total length, then dash (+) and gap (-) lengths.
 _CENTRE_LINETYPE_PATTERN = [20.0, 12.0, -3.0, 2.0, -3.0]
@@ -78,10 +72,19 @@ DXF_VERSION = "R2010"
 CENTRE_MARK_HALF_LENGTH_MODULES = 1.0
 #: Half length of each centre-mark line of a cam drawing (mm).
 CAM_CENTRE_MARK_HALF_LENGTH = 5.0
-#: Height of the gear labels on the train sheet (mm) and their gap below the gear, in modules.
-LABEL_HEIGHT = 3.5
-LABEL_GAP_MODULES = 2.0
-#: How many times the chord tolerance is halved before the dense outline is written as is.
+#: mm: the pitch curve's closing stretch left out, well above any CAM program's joining tolerance.
+PITCH_CURVE_GAP = 1.0
+#: Train sheet: label height (mm), gap (modules) under a gear whose label does not fit inside
+#: it, view titles TITLE_SCALE times taller than the labels.
+LABEL_HEIGHT, LABEL_GAP_MODULES, TITLE_SCALE = 3.5, 2.0, 1.5
+#: A TEXT's extents: TEXT_WIDTH_PER_CHARACTER heights a character (wider than the usual fonts'
+#: average), TEXT_BOX_DEPTH heights down from its top (descenders included).
+TEXT_WIDTH_PER_CHARACTER, TEXT_BOX_DEPTH = 0.8, 1.5
+#: mm: gears whose centres are closer than this share a shaft (drawn in different views).
+SHARED_AXIS_TOLERANCE = 0.01
+#: Train sheet views: the gap between views is this fraction of the widest view (at least
+#: VIEW_GAP_MIN mm); each view's shift along x is a whole multiple of VIEW_SHIFT_STEP mm.
+VIEW_GAP_FRACTION, VIEW_GAP_MIN, VIEW_SHIFT_STEP = 0.15, 10.0, 10.0
 
 _WRITE_LOCK = threading.Lock()
 
@@ -174,6 +177,14 @@ def _plate_problems(outline, pitch_curve, centre, bore, label: str) -> list[str]
     return problems
 
 
+def _finite(value, shape: tuple) -> bool:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return array.shape == shape and bool(np.isfinite(array).all())
+
+
 def _check_tolerance(chord_tolerance) -> float:
     try:
         tolerance = float(chord_tolerance)
@@ -203,7 +214,7 @@ def _fixed_metadata():
             ezdxf.options.write_fixed_meta_data_for_testing = previous
 
 
-def _new_document():
+def _new_document(printed=()):
     import ezdxf
 
     with _fixed_metadata():
@@ -216,26 +227,71 @@ def _new_document():
         doc.linetypes.add(_CENTRE_LINETYPE, pattern=_CENTRE_LINETYPE_PATTERN, description="Centre ____ _ ____ _")
     for name, colour in LAYERS.items():
         layer = doc.layers.add(name, color=colour)
+        layer.dxf.plot = 1 if name in CUTTING_LAYERS or name in printed else 0
+        layer.description = ("cutting path" if name in CUTTING_LAYERS else
+                             "annotation: printed, never cut" if name in printed
+                             else "construction: not cut, not plotted")
         if name in _CENTRE_LINE_LAYERS:
             layer.dxf.linetype = _CENTRE_LINETYPE
     return doc
+
+
+def _add_centre_mark(msp, centre, half: float) -> None:
+    cx, cy = float(centre[0]), float(centre[1])
+    msp.add_line((cx - half, cy), (cx + half, cy), dxfattribs={"layer": CENTRE_LAYER})
+    msp.add_line((cx, cy - half), (cx, cy + half), dxfattribs={"layer": CENTRE_LAYER})
 
 
 def _add_gear(msp, outline: np.ndarray, pitch: np.ndarray, centre: np.ndarray, bore_radius: float,
               module: float) -> None:
     """Add one placed gear's entities (already in sheet coordinates) to the modelspace."""
     msp.add_lwpolyline(outline.tolist(), format="xy", close=True, dxfattribs={"layer": "OUTLINE"})
-    msp.add_lwpolyline(pitch.tolist(), format="xy", close=True, dxfattribs={"layer": "PITCH"})
+    msp.add_lwpolyline(open_ring(pitch, PITCH_CURVE_GAP).tolist(), format="xy", close=False,
+                       dxfattribs={"layer": PITCH_LAYER})
     if bore_radius > 0:
         msp.add_circle(centre.tolist(), bore_radius, dxfattribs={"layer": "BORE"})
-    half = CENTRE_MARK_HALF_LENGTH_MODULES * module
-    cx, cy = float(centre[0]), float(centre[1])
-    msp.add_line((cx - half, cy), (cx + half, cy), dxfattribs={"layer": "CENTRE"})
-    msp.add_line((cx, cy - half), (cx, cy + half), dxfattribs={"layer": "CENTRE"})
+    _add_centre_mark(msp, centre, CENTRE_MARK_HALF_LENGTH_MODULES * module)
+
+
+def _text_box(anchor, text: str, height: float) -> np.ndarray:
+    """[[xmin, ymin], [xmax, ymax]] counted for a TOP_CENTER text hung from ``anchor``."""
+    half = 0.5 * TEXT_WIDTH_PER_CHARACTER * len(text) * height
+    x, y = float(anchor[0]), float(anchor[1])
+    return np.array([[x - half, y - TEXT_BOX_DEPTH * height], [x + half, y]])
+
+
+def _add_label(msp, anchor, text: str, height: float) -> None:
+    from ezdxf.enums import TextEntityAlignment
+
+    msp.add_text(text, height=float(height), dxfattribs={"layer": LABEL_LAYER}).set_placement(
+        (float(anchor[0]), float(anchor[1])), align=TextEntityAlignment.TOP_CENTER)
+
+
+def _set_extents(doc) -> None:
+    """$EXTMIN/$EXTMAX and $LIMMIN/$LIMMAX from the drawn entities (TEXT as :func:`_text_box`)."""
+    from ezdxf import bbox
+
+    msp = doc.modelspace()
+    box = bbox.extents(entity for entity in msp if entity.dxftype() != "TEXT")
+    corners = [np.array([box.extmin, box.extmax])[:, :2]] if box.has_data else []
+    corners += [_text_box(text.dxf.align_point, text.dxf.text, text.dxf.height)
+                for text in msp.query("TEXT")]
+    if not corners:
+        return
+    corners = np.vstack(corners)
+    (x0, y0), (x1, y1) = corners.min(axis=0).tolist(), corners.max(axis=0).tolist()
+    # ezdxf copies the modelspace's own extents and limits into the header when it writes
+    msp.reset_extents((x0, y0, 0.0), (x1, y1, 0.0))
+    msp.reset_limits((x0, y0), (x1, y1))
+    # open zoomed to the drawing (a 3:2 window)
+    doc.set_modelspace_vport(height=1.1 * max(y1 - y0, (x1 - x0) / 1.5),
+                             center=((x0 + x1) / 2, (y0 + y1) / 2))
 
 
 def _audited_bytes(doc, path: Path) -> bytes:
-    """Audit ``doc`` and serialise it; raise :class:`DxfExportError` rather than return a bad file."""
+    """Set the extents, audit ``doc`` and serialise it; raise :class:`DxfExportError` rather
+    than return a bad file."""
+    _set_extents(doc)
     auditor = doc.audit()
     if auditor.has_errors or auditor.has_fixes:
         # A freshly built document needs no fixes; any fix means our geometry was wrong.
@@ -287,9 +343,10 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
 
     Notes
     -----
-    Layers: ``OUTLINE`` (one closed LWPOLYLINE), ``BORE`` (CIRCLE, if any),
-    ``PITCH`` (closed LWPOLYLINE), ``CENTRE`` (two LINEs crossing at the centre,
-    two modules long). The outline is written counter-clockwise.
+    Cutting layers (plotted): ``OUTLINE`` (one closed LWPOLYLINE, counter-clockwise),
+    ``BORE`` (CIRCLE, if any). Construction layers (not plotted): ``CONSTRUCTION-PITCH``
+    (open LWPOLYLINE, its closing stretch of at least :data:`PITCH_CURVE_GAP` left out),
+    ``CONSTRUCTION-CENTRE`` (two LINEs crossing at the centre, two modules long).
     """
     tolerance = _check_tolerance(chord_tolerance)
     problems = _gear_problems(profile)
@@ -306,113 +363,13 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     return DxfSummary(path, len(outline), used, area, perimeter)
 
 
-def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: float = 0.005,
-                      label_height: float = LABEL_HEIGHT) -> tuple[DxfSummary, ...]:
-    """Write an assembled sheet: several gears at given poses on one DXF drawing (mm).
-
-    Parameters
-    ----------
-    path : str or path-like
-        Target file; its directory must exist. An existing file is replaced atomically.
-    placements : sequence of (GearProfile, float, (float, float))
-        ``(profile, angle, offset)``: each gear rotated by ``angle`` (rad) about its
-        centre, then moved by ``offset`` (mm), as :meth:`GearProfile.placed` does.
-    chord_tolerance : float, default 0.005
-        mm, finite and > 0; as in :func:`write_gear_dxf`.
-    label_height : float, default 3.5
-        mm, height of the name labels.
-
-    Returns
-    -------
-    tuple of DxfSummary
-        One per placement, in order (all with the sheet's ``path``); area and
-        perimeter are those of the written outline (a pose does not change them).
-
-    Raises
-    ------
-    DxfInputError
-        (also ``ValueError``) listing every bad placement, profile or tolerance.
-    DxfExportError
-        If the document fails ``ezdxf``'s audit; no file is written then.
-
-    Notes
-    -----
-    Per gear: a closed LWPOLYLINE on ``OUTLINE`` and on ``PITCH``, a CIRCLE on
-    ``BORE`` (if any), a centre mark on ``CENTRE``, and a TEXT with the gear's
-    name on ``LABELS``, centred below the gear.
-    """
-    from ezdxf.enums import TextEntityAlignment
-
-    tolerance = _check_tolerance(chord_tolerance)
-    placements = list(placements)
-    problems = []
-    if not placements:
-        problems.append("placements is empty: a sheet needs at least one gear")
-    if not (isinstance(label_height, (int, float)) and math.isfinite(label_height) and label_height > 0):
-        problems.append(f"label_height must be a finite number > 0 mm, got {label_height!r}")
-    for index, placement in enumerate(placements):
-        try:
-            profile, angle, offset = placement
-        except (TypeError, ValueError):
-            problems.append(f"placements[{index}] must be (profile, angle, (x, y)), got {placement!r}")
-            continue
-        label = f"placements[{index}] (gear {getattr(profile, 'name', '?')!r})"
-        try:
-            angle_ok = math.isfinite(float(angle))
-        except (TypeError, ValueError):
-            angle_ok = False
-        if not angle_ok:
-            problems.append(f"{label}: angle must be a finite number (rad), got {angle!r}")
-        try:
-            offset_array = np.asarray(offset, dtype=float)
-            offset_ok = offset_array.shape == (2,) and bool(np.isfinite(offset_array).all())
-        except (TypeError, ValueError):
-            offset_ok = False
-        if not offset_ok:
-            problems.append(f"{label}: offset must be two finite numbers (mm), got {offset!r}")
-        name = getattr(profile, "name", None)
-        if not isinstance(name, str) or not name.strip() or any(ord(ch) < 32 for ch in name):
-            problems.append(f"{label}: name must be a non-empty single-line string, got {name!r}")
-        problems += _gear_problems(profile, label=label)
-    if problems:
-        raise DxfInputError("cannot export the train sheet to DXF", problems)
-
-    path = Path(path)
-    doc = _new_document()
-    msp = doc.modelspace()
-    summaries = []
-    thinned = {}  # the same profile placed twice is thinned once
-    for profile, angle, offset in placements:
-        key = id(profile)
-        if key not in thinned:
-            thinned[key] = _thin_gear(profile, closed_points(profile.outline),
-                                      closed_points(profile.pitch_curve), tolerance)
-        outline, used, pitch = thinned[key]
-        rotation = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
-        centre = np.asarray(profile.centre, dtype=float)
-        move = np.asarray(offset, dtype=float)
-        placed_outline = (outline - centre) @ rotation.T + centre + move
-        placed_pitch = (pitch - centre) @ rotation.T + centre + move
-        placed_centre = centre + move
-        module = float(profile.module)
-        _add_gear(msp, placed_outline, placed_pitch, placed_centre, float(profile.bore_radius), module)
-        label_y = float(placed_outline[:, 1].min()) - LABEL_GAP_MODULES * module
-        msp.add_text(profile.name, height=float(label_height), dxfattribs={"layer": "LABELS"}).set_placement(
-            (float(placed_centre[0]), label_y), align=TextEntityAlignment.TOP_CENTER)
-        area, perimeter = ring_measures(outline)
-        summaries.append(DxfSummary(path, len(outline), used, area, perimeter))
-    write_bytes_atomic(path, _audited_bytes(doc, path))
-    return tuple(summaries)
-
-
 def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius: float = 0.0,
                   chord_tolerance: float = 0.005, label: str = "cam") -> DxfSummary:
     """Write a plate cam as a DXF cutting file (mm), laid out like a gear file.
 
-    ``contour`` (the working profile) goes on ``OUTLINE`` as the one closed cutting
-    path, ``pitch_curve`` (the roller centre's path) on ``PITCH``, the bore on
-    ``BORE`` and a 10-mm centre mark at the origin (the cam's axis) on ``CENTRE``.
-    Thinning, audit, atomic and deterministic writing as :func:`write_gear_dxf`.
+    ``contour`` (the working profile) on ``OUTLINE`` (the one closed cutting path), the bore
+    on ``BORE``; ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and
+    a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as :func:`write_gear_dxf`.
     """
     tolerance = _check_tolerance(chord_tolerance)
     centre = np.zeros(2)
@@ -428,17 +385,3 @@ def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius:
     write_bytes_atomic(path, _audited_bytes(doc, path))
     area, perimeter = ring_measures(outline)
     return DxfSummary(path, len(outline), used, area, perimeter)
-
-
-def write_train_files(train, folder, chord_tolerance: float) -> list:
-    """One DXF per gear and an assembled sheet of the train at the start position."""
-    from cadgen.gears.trains import _placements
-
-    written = []
-    for profile, _, _, _ in train.gears:
-        summary = write_gear_dxf(folder / f"{profile.file_stem}.dxf", profile,
-                                 chord_tolerance=chord_tolerance)
-        written.append(summary.path)
-    write_train_sheet(folder / "train.dxf", _placements(train), chord_tolerance=chord_tolerance)
-    written.append(folder / "train.dxf")
-    return written

@@ -5,18 +5,28 @@ rebuilt without churn:
 
 STL
     trimesh writes an all-zero 80-byte header (no name, no date) followed by the
-    face count and float32 normals and vertices: deterministic as it stands.
+    face count and float32 normals and vertices: deterministic as it stands. A
+    build writes each part in its printing pose (:meth:`SolidsOutcome.printing_mesh
+    <cadgen.solids.outcome.SolidsOutcome.printing_mesh>`), in mm.
 GLB
-    trimesh's glTF writer has no clock or random input; its JSON carries each
-    mesh's ``metadata`` as ``extras``, though, and loaded meshes carry things like
-    a file path there. So the scene is built from fresh copies whose metadata is
-    only the part's name.
+    Written here, by the glTF 2.0 rules, with json and struct (no trimesh): in
+    metres, glTF's unit (the millimetres are scaled when written, vertices and
+    node translations both, so every viewer agrees without a root scale); vertex
+    normals (split where faces meet at more than :data:`CREASE_ANGLE_DEG`, so flat
+    faces stay flat and tessellated curves are shaded smooth; unit length); one
+    named node per placed part with its rigid transform; one mesh per distinct
+    geometry (a part both arms use is stored once); one material per part kind
+    (:data:`PART_MATERIALS`: base colour, housings and soil translucent with
+    ``alphaMode`` BLEND); accessor ``min``/``max`` on every POSITION; unsigned
+    16-bit indices (32-bit for a mesh of 65535 vertices or more), every buffer view
+    on a 4-byte boundary. Nothing depends on a clock, a path or object identity.
 3MF
     Needs ``lxml`` and ``networkx`` (trimesh's soft dependencies). trimesh fixes
     the zip timestamps (1980-01-01) but gives every object, item and the build a
     random ``p:UUID`` (``uuid.uuid4``); those are replaced here, in order of
     appearance, by UUIDs derived from the model's content, and the zip is written
-    again with the same entries, order, compression and timestamps.
+    again with the same entries, order, compression and timestamps. 3MF declares
+    its unit (``unit="millimeter"`` on the model), so it stays in mm.
 
 File writers go through :func:`cadgen.export.atomic.write_bytes_atomic`. trimesh is
 imported inside the functions.
@@ -26,7 +36,9 @@ from __future__ import annotations
 
 import hashlib
 import io
+import json
 import re
+import struct
 import uuid
 import zipfile
 from enum import Enum
@@ -39,6 +51,9 @@ from cadgen.solids.errors import ExportFormatError, SolidInputError
 
 __all__ = [
     "AssemblyFormat",
+    "GLTF_METRES_PER_MM",
+    "CREASE_ANGLE_DEG",
+    "PART_MATERIALS",
     "stl_bytes",
     "assembly_bytes",
     "load_volume",
@@ -52,6 +67,28 @@ _ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
 _UUID = re.compile(rb"[0-9a-fA-F]{8}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{4}-[0-9a-fA-F]{12}")
 #: Namespace of the UUIDs written into 3MF files (uuid5 of the project's name).
 _UUID_NAMESPACE = uuid.uuid5(uuid.NAMESPACE_DNS, "cadgen.solids")
+
+#: glTF's unit is the metre (glTF 2.0, "Coordinate System and Units"); parts are in mm.
+GLTF_METRES_PER_MM = 1e-3
+#: Faces meeting at more than this angle (deg) get separate vertex normals (a sharp edge).
+CREASE_ANGLE_DEG = 30.0
+#: A material per part kind: sRGB colour, opacity (below 1: alphaMode BLEND), metalness.
+#: Housings and the soil are see-through, so the gears inside them show.
+PART_MATERIALS = {
+    "gear": (0x7F93AA, 1.0, 0.35),
+    "housing": (0xAAB4C0, 0.3, 0.1),
+    "cam": (0x6D8F3C, 1.0, 0.1),
+    "planter": (0xE08A2C, 1.0, 0.1),
+    "blade": (0xC8432B, 1.0, 0.2),
+    "rocker": (0x3C7FB0, 1.0, 0.1),
+    "needle": (0x3A3F47, 1.0, 0.3),
+    "ground": (0x9B7653, 0.35, 0.0),
+    "part": (0x8C8C8C, 1.0, 0.1),   # a part of no known kind
+}
+_GLB_MAGIC, _GLB_JSON, _GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
+_FLOAT, _UINT16, _UINT32 = 5126, 5123, 5125       # accessor component types
+_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
+_TRIANGLES = 4
 
 
 class AssemblyFormat(str, Enum):
@@ -80,23 +117,24 @@ def stl_bytes(mesh) -> bytes:
 def _clean_copy(mesh, name: str):
     import trimesh
 
-    # Fresh geometry: only the name travels as metadata (see the module notes),
-    # and no cached visuals or normals of the caller's mesh leak into the file.
+    # Fresh geometry for trimesh's 3MF writer: only the name travels as metadata, and
+    # no cached visuals of the caller's mesh (or a loaded file's path) leak into the file.
     return trimesh.Trimesh(vertices=np.asarray(mesh.vertices, dtype=np.float64),
                            faces=np.asarray(mesh.faces, dtype=np.int64),
                            process=False, metadata={"name": name})
 
 
-def _scene(parts):
-    import trimesh
-
-    scene = trimesh.Scene()
-    seen = set()
+def _checked(parts) -> list:
+    """``[(name, mesh, transform, kind)]`` of ``(name, mesh, transform[, kind])`` parts, checked."""
+    checked, seen = [], set()
     for index, part in enumerate(parts):
         try:
-            name, mesh, transform = part
+            name, mesh, transform, *rest = part
+            if len(rest) > 1:
+                raise ValueError
         except (TypeError, ValueError):
-            raise SolidInputError("parts", f"part {index} must be (name, mesh, 4x4 transform), not {part!r}") from None
+            raise SolidInputError("parts", f"part {index} must be (name, mesh, 4x4 transform[, kind]), "
+                                           f"not {part!r}") from None
         name = str(name)
         if not name or name in seen:
             raise SolidInputError("parts", f"part names must be unique and non-empty; part {index} is {name!r}")
@@ -106,10 +144,151 @@ def _scene(parts):
                 or not np.array_equal(transform[3], [0.0, 0.0, 0.0, 1.0]):
             raise SolidInputError("parts", f"part {name!r} needs a finite 4x4 homogeneous transform "
                                            f"(last row 0 0 0 1), not {transform.tolist()}")
-        scene.add_geometry(_clean_copy(mesh, name), node_name=name, geom_name=name, transform=transform)
-    if not seen:
+        kind = str(rest[0]) if rest and rest[0] is not None else "part"
+        checked.append((name, mesh, transform, kind))
+    if not checked:
         raise SolidInputError("parts", "an assembly needs at least one part")
+    return checked
+
+
+def _scene(parts):
+    import trimesh
+
+    scene = trimesh.Scene()
+    for name, mesh, transform, _ in _checked(parts):
+        scene.add_geometry(_clean_copy(mesh, name), node_name=name, geom_name=name, transform=transform)
     return scene
+
+
+def _shaded(mesh, crease_deg: float = CREASE_ANGLE_DEG):
+    """Vertices split at sharp edges, with vertex normals: (positions (n, 3), normals (n, 3), faces (m, 3)).
+
+    Each corner's normal is the corner-angle-weighted mean of the normals of the
+    faces round its vertex that lie within ``crease_deg`` of its own face; corners
+    of a vertex with equal normals share one vertex. Unit length; a corner whose
+    faces cancel (degenerate) takes its face's normal, or +z.
+    """
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    triangles = vertices[faces]
+    cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    length = np.linalg.norm(cross, axis=1)
+    face_normals = cross / np.where(length > 0, length, 1.0)[:, None]
+    edges = np.roll(triangles, -1, axis=1) - triangles            # corner k -> k + 1
+    before = -np.roll(edges, 1, axis=1)                            # corner k -> k - 1
+    norms = np.linalg.norm(edges, axis=2) * np.linalg.norm(before, axis=2)
+    cosines = np.einsum("fkc,fkc->fk", edges, before) / np.where(norms > 0, norms, 1.0)
+    corner_angles = np.arccos(np.clip(cosines, -1.0, 1.0)).ravel()
+    corner_vertex = faces.ravel()
+    corner_face = np.repeat(np.arange(len(faces)), 3)
+    # every pair of corners at one vertex: the corners sorted by vertex, then each
+    # corner paired with every corner of its run
+    order = np.argsort(corner_vertex, kind="stable")
+    runs = np.flatnonzero(np.r_[True, corner_vertex[order][1:] != corner_vertex[order][:-1]])
+    counts = np.diff(np.r_[runs, len(order)])
+    run_of = np.repeat(np.arange(len(runs)), counts)
+    repeat = counts[run_of]
+    first = np.repeat(np.arange(len(order)), repeat)
+    offset = np.arange(len(first)) - np.repeat(np.cumsum(repeat) - repeat, repeat)
+    second = runs[run_of[first]] + offset
+    this, other = order[first], order[second]
+    near = np.einsum("ij,ij->i", face_normals[corner_face[this]], face_normals[corner_face[other]]) \
+        >= np.cos(np.radians(crease_deg))
+    summed = np.zeros((len(corner_vertex), 3))
+    np.add.at(summed, this[near], corner_angles[other[near], None] * face_normals[corner_face[other[near]]])
+    size = np.linalg.norm(summed, axis=1)
+    fallback = face_normals[corner_face]
+    fallback[np.linalg.norm(fallback, axis=1) == 0] = (0.0, 0.0, 1.0)
+    normals = np.where((size > 1e-12)[:, None], summed / np.where(size > 0, size, 1.0)[:, None], fallback)
+    keys = np.column_stack([corner_vertex.astype(np.float64), normals])
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    return vertices[unique[:, 0].astype(np.int64)], unique[:, 1:], inverse.reshape(-1, 3)
+
+
+def _linear(srgb: int) -> list:
+    """An sRGB colour (0xRRGGBB) as glTF's linear base colour components."""
+    channels = np.array([(srgb >> 16) & 255, (srgb >> 8) & 255, srgb & 255]) / 255.0
+    linear = np.where(channels <= 0.04045, channels / 12.92, ((channels + 0.055) / 1.055) ** 2.4)
+    return [round(float(c), 6) for c in linear]
+
+
+def _material(kind: str) -> dict:
+    colour, opacity, metalness = PART_MATERIALS.get(kind, PART_MATERIALS["part"])
+    material = {"name": kind,
+                "pbrMetallicRoughness": {"baseColorFactor": _linear(colour) + [opacity],
+                                         "metallicFactor": metalness, "roughnessFactor": 0.6}}
+    if opacity < 1.0:
+        # see-through: blended, and both sides drawn so the inner walls show
+        material.update(alphaMode="BLEND", doubleSided=True)
+    return material
+
+
+def _glb(parts) -> bytes:
+    """Binary glTF 2.0 of checked parts, in metres (see the module notes)."""
+    tree = {"asset": {"version": "2.0", "generator": "cadgen"}, "scene": 0,
+            "scenes": [{"name": "assembly", "nodes": []}], "nodes": [], "meshes": [],
+            "materials": [], "accessors": [], "bufferViews": [], "buffers": []}
+    chunks, length = [], 0
+    materials, meshes = {}, {}
+
+    def view(data: np.ndarray, target: int) -> int:
+        nonlocal length
+        payload = data.tobytes()
+        tree["bufferViews"].append({"buffer": 0, "byteOffset": length, "byteLength": len(payload),
+                                    "target": target})
+        # every view starts on 4 bytes, so each accessor is aligned to its component size
+        payload += b"\0" * (-len(payload) % 4)
+        chunks.append(payload)
+        length += len(payload)
+        return len(tree["bufferViews"]) - 1
+
+    def accessor(data: np.ndarray, kind: str, component: int, target: int, bounds=False) -> int:
+        entry = {"bufferView": view(data, target), "componentType": component,
+                 "count": int(len(data)), "type": kind}
+        if bounds:   # from the stored float32 values, as the spec asks
+            entry["min"] = [float(v) for v in data.min(axis=0)]
+            entry["max"] = [float(v) for v in data.max(axis=0)]
+        tree["accessors"].append(entry)
+        return len(tree["accessors"]) - 1
+
+    for name, mesh, transform, kind in parts:
+        if kind not in materials:
+            tree["materials"].append(_material(kind))
+            materials[kind] = len(tree["materials"]) - 1
+        vertices = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+        faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+        if len(faces) == 0:
+            raise SolidInputError("parts", f"part {name!r} has no faces")
+        key = hashlib.sha256(kind.encode() + b"\0" + vertices.tobytes() + faces.tobytes()).digest()
+        if key not in meshes:
+            positions, normals, triangles = _shaded(mesh)
+            primitive = {
+                "attributes": {
+                    "POSITION": accessor((positions * GLTF_METRES_PER_MM).astype("<f4"), "VEC3",
+                                         _FLOAT, _ARRAY_BUFFER, bounds=True),
+                    "NORMAL": accessor(normals.astype("<f4"), "VEC3", _FLOAT, _ARRAY_BUFFER)},
+                # 16-bit indices when they fit (65535 is the restart value: below it)
+                "indices": accessor(triangles.ravel().astype("<u2"), "SCALAR", _UINT16,
+                                    _ELEMENT_ARRAY_BUFFER) if len(positions) < 65535 else
+                accessor(triangles.ravel().astype("<u4"), "SCALAR", _UINT32, _ELEMENT_ARRAY_BUFFER),
+                "material": materials[kind], "mode": _TRIANGLES}
+            tree["meshes"].append({"name": name, "primitives": [primitive]})
+            meshes[key] = len(tree["meshes"]) - 1
+        node = {"name": name, "mesh": meshes[key]}
+        if not np.array_equal(transform, np.eye(4)):
+            placed = transform.copy()
+            placed[:3, 3] *= GLTF_METRES_PER_MM
+            node["matrix"] = [float(v) for v in placed.T.ravel()]   # column-major
+        tree["nodes"].append(node)
+        tree["scenes"][0]["nodes"].append(len(tree["nodes"]) - 1)
+    tree["buffers"].append({"byteLength": length})
+    content = json.dumps(tree, separators=(",", ":"), allow_nan=False).encode("utf-8")
+    content += b" " * (-len(content) % 4)
+    binary = b"".join(chunks)   # padded to 4 bytes view by view
+    total = 12 + 8 + len(content) + 8 + len(binary)
+    return b"".join([struct.pack("<III", _GLB_MAGIC, 2, total),
+                     struct.pack("<II", len(content), _GLB_JSON), content,
+                     struct.pack("<II", len(binary), _GLB_BIN), binary])
 
 
 def _three_mf_writer():
@@ -154,19 +333,20 @@ def _deterministic_3mf(data: bytes) -> bytes:
 
 
 def assembly_bytes(parts, file_type: str | AssemblyFormat = AssemblyFormat.GLB) -> bytes:
-    """An assembly file: one node per part, placed by its transform.
+    """An assembly file: one named node per part, placed by its transform.
 
     Parameters
     ----------
-    parts : sequence of (str, trimesh.Trimesh, (4, 4) float)
-        ``(name, mesh, transform)``: unique non-empty names, meshes in mm in the
-        part's frame, homogeneous transforms part frame -> assembly frame.
+    parts : sequence of (str, trimesh.Trimesh, (4, 4) float[, str])
+        ``(name, mesh, transform[, kind])``: unique non-empty names, meshes in mm in
+        the part's frame, homogeneous transforms part frame -> assembly frame (mm),
+        and the part's kind (a key of :data:`PART_MATERIALS`; its material in a GLB).
     file_type : {"glb", "3mf"} or AssemblyFormat
 
     Returns
     -------
     bytes
-        Deterministic (see the module notes).
+        Deterministic (see the module notes). GLB in metres, 3MF in millimetres.
 
     Raises
     ------
@@ -183,16 +363,15 @@ def assembly_bytes(parts, file_type: str | AssemblyFormat = AssemblyFormat.GLB) 
     if kind is AssemblyFormat.THREE_MF:
         writer = _three_mf_writer()  # before building anything: fail fast
         return _deterministic_3mf(writer(_scene(parts)))
-    from trimesh.exchange.gltf import export_glb
-
-    return export_glb(_scene(parts))
+    return _glb(_checked(parts))
 
 
 def load_volume(data: bytes, file_type: str) -> float:
     """Total volume (mm^3) of an exported file, read back with trimesh.
 
     Each geometry's volume is counted once per node that places it, scaled by
-    the determinant of the node's transform (1 for a rigid placement).
+    the determinant of the node's transform (1 for a rigid placement). glTF is
+    in metres (its unit by definition): its volumes are converted to mm^3.
 
     Parameters
     ----------
@@ -211,6 +390,8 @@ def load_volume(data: bytes, file_type: str) -> float:
     for node in scene.graph.nodes_geometry:
         transform, geometry_name = scene.graph[node]
         total += scene.geometry[geometry_name].volume * float(np.linalg.det(transform[:3, :3]))
+    if str(file_type).lower() in ("glb", "gltf"):
+        total /= GLTF_METRES_PER_MM ** 3
     return total
 
 
@@ -241,16 +422,17 @@ def write_solids(outcome, staging) -> list:
     """Write ``solids/<part>.stl`` and ``solids/assembly.<glb|3mf>``; return the relative paths.
 
     ``outcome`` is a :class:`cadgen.solids.outcome.SolidsOutcome`. One binary STL per
-    distinct part in its own frame (a part both planting arms use is written once), and
-    the assembly with every instance placed at the outcome's carrier angle.
+    distinct part in its printing pose (largest flat face down on z = 0, centred on
+    x = y = 0; a part both planting arms use is written once), and the assembly with
+    every instance placed, from its part's own frame, at the outcome's carrier angle.
     """
     folder = staging / "solids"
     folder.mkdir()
     written = []
     for part in outcome.assembly.parts:
-        (folder / f"{part.name}.stl").write_bytes(stl_bytes(part.mesh))
+        (folder / f"{part.name}.stl").write_bytes(stl_bytes(outcome.printing_mesh(part)))
         written.append(f"solids/{part.name}.stl")
-    placed = [(name, part.mesh, pose) for name, part, pose
+    placed = [(name, part.mesh, pose, part.kind) for name, part, pose
               in outcome.assembly.placements(outcome.carrier_angle)]
     (folder / f"assembly.{outcome.file_type}").write_bytes(
         assembly_bytes(placed, outcome.file_type))

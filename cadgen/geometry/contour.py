@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 __all__ = ["closed_points", "ring_problems", "thin_ring", "thin_outline", "ring_measures",
-           "thinned_outline", "thinned_contour", "MAX_TOLERANCE_HALVINGS"]
+           "open_ring", "thinned_outline", "thinned_contour", "MAX_TOLERANCE_HALVINGS"]
 
 MAX_TOLERANCE_HALVINGS = 30
 
@@ -112,6 +112,15 @@ def ring_measures(points: np.ndarray) -> tuple[float, float]:
     area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
     perimeter = float(np.linalg.norm(np.roll(points, -1, axis=0) - points, axis=1).sum())
     return area, perimeter
+
+
+def open_ring(points: np.ndarray, gap: float) -> np.ndarray:
+    """A closed ring (n, 2), first point not repeated, as an open polyline whose ends are at
+    least ``gap`` apart: the trailing points within ``gap`` of the first are left out (a ring
+    smaller than ``gap`` is returned whole, its closing segment left out)."""
+    points = np.asarray(points, dtype=float)
+    far = np.flatnonzero(np.linalg.norm(points - points[0], axis=1) >= gap)
+    return points if far.size == 0 else points[: far[-1] + 1]
 
 
 def thin_outline(points: np.ndarray, tolerance: float, centre, bore_radius: float):

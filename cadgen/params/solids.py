@@ -4,20 +4,24 @@
 each may be left out and is then derived from the module of the gears the housing
 encloses. ``[ground]`` is the soil surface as a mesh (flat or a ridge). ``[solids]``
 holds the mesh resolution, the density for the mass properties and the pose of
-the assembly file.
+the assembly file, and the printer's build volume the printed parts are checked against.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import Field, field_validator
+from pydantic import BeforeValidator, Field, field_validator
 from pydantic_core import PydanticCustomError
 
-from cadgen.params._tables import _Table
+from cadgen.params._tables import _list_to_tuple, _Table
 
-__all__ = ["MIN_WALL", "ShellParameters", "GroundParameters", "SolidsParameters"]
+__all__ = ["MIN_WALL", "DEFAULT_BUILD_VOLUME", "ShellParameters", "GroundParameters",
+           "SolidsParameters"]
+
+#: A common printer bed (x, y, z in mm): 256 mm cube printers are widespread.
+DEFAULT_BUILD_VOLUME = (256.0, 256.0, 256.0)
 
 #: The thinnest housing wall accepted (mm): thinner cast or welded walls do not hold a bearing.
 MIN_WALL = 2.0
@@ -76,6 +80,13 @@ class SolidsParameters(_Table):
     assembly_carrier_angle_deg: float = Field(0.0, description="carrier angle of the assembly file, "
                                                                "deg (0 = catching)")
     assembly_format: Literal["glb", "3mf"] = Field("glb", description='"glb" or "3mf"')
+    build_volume: Annotated[
+        tuple[Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)],
+              Annotated[float, Field(gt=0)]],
+        BeforeValidator(_list_to_tuple)] = Field(
+        DEFAULT_BUILD_VOLUME,
+        description="printer build volume [x, y, z], mm: every part's printing pose (largest "
+                    "flat face down, turned 90 deg about z if that fits) is checked against it")
 
     @property
     def assembly_carrier_angle_rad(self) -> float:

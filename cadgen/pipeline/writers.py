@@ -34,7 +34,7 @@ def writers_for(run) -> list:
 
 
 def _write_gears(run, staging):
-    from cadgen.export.dxf import write_train_files
+    from cadgen.export.train_sheet import write_train_files
 
     (staging / "gears").mkdir()
     return [f"gears/{Path(path).name}" for path in

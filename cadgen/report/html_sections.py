@@ -307,6 +307,15 @@ def _solids_section(report: dict) -> str:
         body.append("<h3>Enclosure</h3>" + _table(
             ["housing", "encloses its gears", "smallest margin", "nearest gear", "axial fit"],
             enclosure, numeric=(2,), row_classes=classes))
+    too_big = solids.get("too_big_for_build_volume") or []
+    if too_big:
+        volume = " x ".join(_number(v, trim=True) for v in solids.get("build_volume_mm") or [])
+        body.append(f"<h3>Parts larger than the build volume ({_e(volume)} mm)</h3>" + _table(
+            ["part", "kind", "printing-pose extents (mm)", "fits"],
+            [[_e(p["part"]), _e(p["kind"]),
+              _e(" x ".join(_number(v, 1) for v in p["print_extents_mm"])),
+              _badge("warn").replace("WARN", "TOO BIG")]
+             for p in too_big], numeric=(2,)))
     if solids.get("frames"):
         body.append(f'<p class="note">{_e(solids["frames"])}</p>')
     return _section("solids", "Solids", "".join(body))

@@ -198,6 +198,12 @@ def format_solids(solids: dict) -> str:
                  else "; the gears' faces do not fit between its floor and roof")
         lines.append(f"     {row['housing']} {state} (smallest margin {_number(margin, '.2f')} mm, "
                      f"{row.get('nearest_gear') or MISSING}{axial})")
+    volume = solids.get("build_volume_mm")
+    for part in solids.get("too_big_for_build_volume") or []:
+        size = " x ".join(_number(v, ".1f") for v in part["print_extents_mm"])
+        bed = " x ".join(_number(v, "g") for v in volume) if volume else MISSING
+        lines.append(f"     warning: {part['part']} ({part['kind']}) is {size} mm in its printing "
+                     f"pose, larger than the build volume {bed} mm (solids.build_volume)")
     return "\n".join(lines)
 
 

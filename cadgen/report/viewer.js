@@ -55,40 +55,19 @@
     render();
   }
 
-  // A colour per kind of part, from its node name (the GLB carries no materials).
-  var KINDS = [
-    [/^ground/, {color: 0x9b7653, opacity: 0.35}],
-    [/^(gearbox|gear-case)/, {color: 0xaab4c0, opacity: 0.3}],
-    [/^(blade|planter)/, {color: 0xe08a2c}],
-    [/^cam/, {color: 0x6d8f3c}],
-    [/^needle/, {color: 0x3a3f47}],
-    [/^rocker/, {color: 0x3c7fb0}],
-    [/./, {color: 0x7f93aa, metalness: 0.35}]
-  ];
-  function material(name) {
-    for (var i = 0; i < KINDS.length; i++) {
-      if (KINDS[i][0].test(name)) {
-        var k = KINDS[i][1];
-        return new T.MeshStandardMaterial({
-          color: k.color, metalness: k.metalness || 0.1, roughness: 0.6, side: T.DoubleSide,
-          transparent: k.opacity !== undefined, opacity: k.opacity === undefined ? 1 : k.opacity,
-          depthWrite: k.opacity === undefined});
-      }
-    }
-  }
-
   var text = document.getElementById("cadgen-glb").textContent.replace(/\s+/g, "");
   var binary = atob(text), bytes = new Uint8Array(binary.length);
   for (var i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
   new T.GLTFLoader().parse(bytes.buffer, "", function (gltf) {
-    var model = gltf.scene;
-    model.scale.setScalar(0.001);   // the GLB is in millimetres; glTF (and this view) in metres
+    var model = gltf.scene;   // in metres, glTF's unit, as the GLB is written
     var fit = new T.Box3();
     model.updateMatrixWorld(true);
     model.traverse(function (node) {
       if (!node.isMesh) return;
       var name = node.name || (node.parent && node.parent.name) || "";
-      node.material = material(name);
+      // the GLB carries a material per kind of part (housings and soil see-through): keep it,
+      // drawn from both sides since a housing's cavity faces inwards
+      if (node.material) node.material.side = T.DoubleSide;
       state.meshes += 1;
       if (!/^ground/.test(name)) fit.expandByObject(node);   // the soil slab is wide: not framed
     });

@@ -4,8 +4,8 @@ The GLB is embedded as base64 and drawn by a vendored build of three.js
 (``vendor/three-viewer.min.js``: WebGLRenderer, GLTFLoader, OrbitControls; its
 version and how it was built are in ``vendor/README.md``), inlined with a small
 script of ours (``viewer.js``): the page fetches nothing, so it works from an
-e-mail attachment or an offline laptop. The GLB is in millimetres; the viewer
-scales it to glTF's metres.
+e-mail attachment or an offline laptop. The GLB is in metres (glTF's unit), as
+the view is: it is drawn unscaled.
 
 :func:`interactive_sections` is what the page calls: the animation section
 (:mod:`cadgen.report.animation`), then this 3D view, with their shared style.
@@ -39,7 +39,7 @@ def viewer_section(glb: bytes | None) -> str:
     Parameters
     ----------
     glb : bytes or None
-        The assembly as binary glTF (``solids/assembly.glb``), in millimetres.
+        The assembly as binary glTF (``solids/assembly.glb``), in metres.
 
     Raises
     ------

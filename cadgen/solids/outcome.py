@@ -1,17 +1,36 @@
 """What a build's solids came to: the assembly, its housings' enclosure checks, mass properties.
 
-The report section lists each part's mass properties at the file's density and, per
-housing, whether its gears stay inside the cavity over a revolution; the files are
-written by :func:`cadgen.export.meshes.write_solids`.
+The report section lists each part's mass properties at the file's density, per
+housing whether its gears stay inside the cavity over a revolution, and each part's
+printing pose (:func:`printing_pose`: largest flat face down on z = 0, centred on
+x = y = 0) checked against the printer's build volume; the files are written by
+:func:`cadgen.export.meshes.write_solids` (the STLs in that pose).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "enclosure_checks"]
+from cadgen.params.solids import DEFAULT_BUILD_VOLUME
+
+__all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "enclosure_checks",
+           "printing_pose", "fits_build_volume", "SUPPORT_RTOL", "FACE_AREA_RTOL",
+           "FOOTPRINT_AREA_RTOL"]
+
+#: A facet lies on a supporting plane of the part (the part can rest on it) when no
+#: vertex is further than this fraction of the part's size on its outer side.
+SUPPORT_RTOL = 1e-9
+#: Flat faces whose areas differ by less than this fraction are equally large: the
+#: one already facing down (-z) is kept, so a gear is not turned over for rounding.
+FACE_AREA_RTOL = 1e-6
+#: A part is turned about z onto its footprint's smallest box only when that box is
+#: smaller by more than this fraction: a round part (a gear, the cam) keeps its angle.
+FOOTPRINT_AREA_RTOL = 0.01
+#: Parts that are not made (the soil slab): not checked against the build volume.
+_NOT_MADE = frozenset({"ground"})
+
 
 @dataclass
 class SolidsOutcome:
@@ -21,6 +40,18 @@ class SolidsOutcome:
     carrier_angle: float     # rad, the assembly file's pose
     density: float
     file_type: str
+    build_volume: tuple = DEFAULT_BUILD_VOLUME   # mm (x, y, z), the printer's
+    _poses: dict = field(default_factory=dict, repr=False)
+
+    def printing_pose(self, part) -> np.ndarray:
+        """The part's printing pose (see :func:`printing_pose`), computed once per part."""
+        if part.name not in self._poses:
+            self._poses[part.name] = printing_pose(part.mesh)
+        return self._poses[part.name]
+
+    def printing_mesh(self, part):
+        """A copy of the part's mesh in its printing pose (what its STL holds)."""
+        return part.mesh.copy().apply_transform(self.printing_pose(part))
 
 
 def solids_outcome(params, assembly, housings) -> SolidsOutcome:
@@ -28,7 +59,128 @@ def solids_outcome(params, assembly, housings) -> SolidsOutcome:
     settings = params.solids
     return SolidsOutcome(assembly, housings, enclosure_checks(assembly, housings),
                          settings.assembly_carrier_angle_rad, settings.density_kg_m3,
-                         settings.assembly_format)
+                         settings.assembly_format, tuple(settings.build_volume))
+
+
+def _turn_onto(normal) -> np.ndarray:
+    """(3, 3) rotation taking the unit vector ``normal`` to -z, about their common normal."""
+    normal = np.asarray(normal, dtype=float)
+    down = np.array([0.0, 0.0, -1.0])
+    cosine = float(np.clip(normal @ down, -1.0, 1.0))
+    axis = np.cross(normal, down)
+    sine = float(np.linalg.norm(axis))
+    if sine < 1e-12:
+        # already down (identity), or straight up: half a turn about x
+        return np.eye(3) if cosine > 0 else np.diag([1.0, -1.0, -1.0])
+    axis /= sine
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
+                      [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + sine * cross + (1.0 - cosine) * cross @ cross   # Rodrigues
+
+
+def _flat_faces(mesh):
+    """Every flat face of a mesh: (areas (k,), unit normals (k, 3), a point of each (k, 3)).
+
+    trimesh's facets (groups of adjacent coplanar triangles) and the triangles in none.
+    """
+    facets = mesh.facets
+    in_facet = np.zeros(len(mesh.faces), dtype=bool)
+    if len(facets):
+        in_facet[np.concatenate(facets)] = True
+    single = np.flatnonzero(~in_facet)
+    areas = np.concatenate([np.asarray(mesh.facets_area, dtype=float).reshape(-1),
+                            mesh.area_faces[single]])
+    normals = np.concatenate([np.asarray(mesh.facets_normal, dtype=float).reshape(-1, 3),
+                              mesh.face_normals[single]])
+    first = np.array([f[0] for f in facets] + single.tolist(), dtype=np.int64)
+    points = mesh.vertices[mesh.faces[first, 0]]
+    return areas, normals, points
+
+
+def _footprint_turn(points) -> np.ndarray:
+    """(3, 3) turn about z making the smallest-area box round ``points``' (n, 2) footprint square
+    with x and y, its long side along x; identity when that saves less than
+    :data:`FOOTPRINT_AREA_RTOL` of the area (a gear, or a part already square with the axes,
+    stays as it is).
+    """
+    from scipy.spatial import ConvexHull
+
+    points = np.asarray(points, dtype=float)
+    try:
+        hull = points[ConvexHull(points).vertices]
+    except Exception:   # a footprint of no area (qhull refuses it): nothing to turn
+        return np.eye(3)
+    edges = np.roll(hull, -1, axis=0) - hull
+    angles = np.arctan2(edges[:, 1], edges[:, 0])
+    cos, sin = np.cos(angles), np.sin(angles)
+    # the hull in each edge's frame (rotated by -angle): the box's sides along the edge
+    along = hull[:, 0][None, :] * cos[:, None] + hull[:, 1][None, :] * sin[:, None]
+    across = -hull[:, 0][None, :] * sin[:, None] + hull[:, 1][None, :] * cos[:, None]
+    widths, heights = np.ptp(along, axis=1), np.ptp(across, axis=1)
+    best = int(np.argmin(widths * heights))
+    current = np.ptp(hull, axis=0)
+    if widths[best] * heights[best] >= current[0] * current[1] * (1.0 - FOOTPRINT_AREA_RTOL):
+        return np.eye(3)
+    angle = angles[best] + (0.0 if widths[best] >= heights[best] else np.pi / 2)
+    c, s = np.cos(-angle), np.sin(-angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def printing_pose(mesh, *, support_rtol: float = SUPPORT_RTOL,
+                  area_rtol: float = FACE_AREA_RTOL) -> np.ndarray:
+    """4x4 rigid transform putting a part on a printer bed: largest flat face down, on z = 0.
+
+    The face is the largest by area among the mesh's flat faces (coplanar adjacent
+    triangles, trimesh's facets) that the part can rest on: its plane supports the
+    part (no vertex beyond it). Its outward normal is turned onto -z (the smallest
+    rotation; a face already down is kept, so is a gear's), then the part is moved
+    so that its lowest point is at z = 0 and its bounding box is centred on x = y = 0.
+    A part with no flat face to rest on stands on the largest face of its convex hull.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        A closed part, mm.
+
+    Returns
+    -------
+    (4, 4) float
+    """
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    if len(mesh.faces) == 0 or not np.isfinite(vertices).all():
+        raise ValueError(f"a printing pose needs a finite mesh with faces, not {len(mesh.faces)} "
+                         f"faces")
+    hull = mesh.convex_hull
+    extreme = np.asarray(hull.vertices, dtype=float)
+    tolerance = support_rtol * max(float(mesh.scale), 1.0)
+    areas, normals, points = _flat_faces(mesh)
+    best = None
+    for index in np.argsort(-areas, kind="stable"):
+        if best is not None and areas[index] < areas[best] * (1.0 - area_rtol):
+            break
+        if np.max((extreme - points[index]) @ normals[index]) > tolerance:
+            continue          # not a face the part can rest on (a cavity's, a recess's)
+        if best is None or normals[index][2] < normals[best][2]:
+            best = index      # among equal faces, the one facing down already
+    if best is None:
+        hull_areas, hull_normals, _ = _flat_faces(hull)
+        normal = hull_normals[int(np.argmax(hull_areas))]
+    else:
+        normal = normals[best]
+    transform = np.eye(4)
+    transform[:3, :3] = _turn_onto(normal / np.linalg.norm(normal))
+    transform[:3, :3] = _footprint_turn((extreme @ transform[:3, :3].T)[:, :2]) @ transform[:3, :3]
+    turned = vertices @ transform[:3, :3].T
+    low, high = turned.min(axis=0), turned.max(axis=0)
+    transform[:3, 3] = [-(low[0] + high[0]) / 2, -(low[1] + high[1]) / 2, -low[2]]
+    return transform
+
+
+def fits_build_volume(extents, build_volume) -> bool:
+    """Whether a box of ``extents`` (x, y, z) fits ``build_volume``, as is or turned 90 deg about z."""
+    x, y, z = (float(v) for v in extents)
+    bx, by, bz = (float(v) for v in build_volume)
+    return z <= bz and ((x <= bx and y <= by) or (y <= bx and x <= by))
 
 
 def enclosure_checks(assembly, housings: dict) -> list:
@@ -76,13 +228,18 @@ def solids_report(outcome: SolidsOutcome) -> dict:
     from cadgen.solids.mass import mass_properties
 
     parts = []
+    too_big = []
     total = 0.0
     for part in outcome.assembly.parts:
         instances = part.instances or ((part.name, part.body, 0.0),)
-        if part.kind == "ground":
+        if part.kind in _NOT_MADE:
             continue
         props = mass_properties(part.mesh, outcome.density)
         total += props["mass_kg"] * len(instances)
+        extents = [float(v) for v in np.ptp(outcome.printing_mesh(part).vertices, axis=0)]
+        fits = fits_build_volume(extents, outcome.build_volume)
+        if not fits:
+            too_big.append({"part": part.name, "kind": part.kind, "print_extents_mm": extents})
         parts.append({
             "part": part.name, "kind": part.kind, "instances": len(instances),
             "file": f"solids/{part.name}.stl", "triangles": int(len(part.mesh.faces)),
@@ -91,10 +248,15 @@ def solids_report(outcome: SolidsOutcome) -> dict:
             "inertia_kg_mm2": props["inertia_kg_mm2"].tolist(),
             "watertight": bool(part.mesh.is_watertight),
             "winding_consistent": bool(part.mesh.is_winding_consistent),
+            "print_extents_mm": extents, "fits_build_volume": fits,
         })
     return {"density_kg_m3": outcome.density, "parts": parts, "total_mass_kg": total,
             "assembly": {"file": f"solids/assembly.{outcome.file_type}",
-                         "carrier_angle_deg": float(np.degrees(outcome.carrier_angle))},
+                         "carrier_angle_deg": float(np.degrees(outcome.carrier_angle)),
+                         "units": "m" if outcome.file_type == "glb" else "mm"},
             "enclosure": outcome.enclosure,
-            "frames": "each STL in its part's own frame (gears: axis at the origin, faces at "
-                      "z = 0 and z = face width); the assembly places every instance"}
+            "build_volume_mm": [float(v) for v in outcome.build_volume],
+            "too_big_for_build_volume": too_big,
+            "frames": "each STL in its printing pose: largest flat face down on z = 0, centred "
+                      "on x = y = 0 (mm); the assembly places every instance from its part's "
+                      "own frame (GLB in metres, 3MF in millimetres)"}
