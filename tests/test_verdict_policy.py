@@ -19,7 +19,8 @@ import pytest
 
 from cadgen.gears.pairs import MIN_ROOT_THICKNESS, circle_pair, generate_pair
 from cadgen.gears.teeth import ToothSystem
-from cadgen.gears.trains import GearStage, GearTrain, circular_module, train_report
+from cadgen.gears.circular import circular_module
+from cadgen.gears.trains import GearStage, GearTrain, train_report
 from cadgen.report.content import failures, verdict_text, check_warnings
 from cadgen.report.html import overall_checks, render_html
 

@@ -16,7 +16,7 @@ from kinematics.clearance import HousingCircle
 from kinematics.errors import DesignError
 from kinematics.planting import PlantingMechanism
 
-from cadgen.gears.trains import circular_module, planting_circular_radii
+from cadgen.gears.circular import circular_module, planting_circular_radii
 
 __all__ = ["ShellSize", "planting_shells", "housing_circles", "envelope_circles"]
 
