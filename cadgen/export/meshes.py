@@ -9,17 +9,14 @@ STL
     build writes each part in its printing pose (:meth:`SolidsOutcome.printing_mesh
     <cadgen.solids.outcome.SolidsOutcome.printing_mesh>`), in mm.
 GLB
-    Written here, by the glTF 2.0 rules, with json and struct (no trimesh): in
-    metres, glTF's unit (the millimetres are scaled when written, vertices and
-    node translations both, so every viewer agrees without a root scale); vertex
-    normals (split where faces meet at more than :data:`CREASE_ANGLE_DEG`, so flat
-    faces stay flat and tessellated curves are shaded smooth; unit length); one
-    named node per placed part with its rigid transform; one mesh per distinct
-    geometry (a part both arms use is stored once); one material per part kind
-    (:data:`PART_MATERIALS`: base colour, housings and soil translucent with
-    ``alphaMode`` BLEND); accessor ``min``/``max`` on every POSITION; unsigned
-    16-bit indices (32-bit for a mesh of 65535 vertices or more), every buffer view
-    on a 4-byte boundary. Nothing depends on a clock, a path or object identity.
+    trimesh's exporter, given: metres, glTF's unit (the millimetres are scaled,
+    vertices and node translations both, so every viewer agrees without a root
+    scale); vertex normals split where faces meet at more than
+    :data:`CREASE_ANGLE_DEG` (``trimesh.graph.smooth_shade``: flat faces stay flat,
+    tessellated curves shade smooth); one named node per placed part with its rigid
+    transform; one geometry per distinct mesh (a part both arms use is stored
+    once); one material per part kind (:data:`PART_MATERIALS`: base colour, housings
+    and soil translucent with ``alphaMode`` BLEND). Deterministic as trimesh writes it.
 3MF
     Needs ``lxml`` and ``networkx`` (trimesh's soft dependencies). trimesh fixes
     the zip timestamps (1980-01-01) but gives every object, item and the build a
@@ -36,9 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import io
-import json
 import re
-import struct
 import uuid
 import zipfile
 from enum import Enum
@@ -85,10 +80,6 @@ PART_MATERIALS = {
     "ground": (0x9B7653, 0.35, 0.0),
     "part": (0x8C8C8C, 1.0, 0.1),   # a part of no known kind
 }
-_GLB_MAGIC, _GLB_JSON, _GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
-_FLOAT, _UINT16, _UINT32 = 5126, 5123, 5125       # accessor component types
-_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
-_TRIANGLES = 4
 
 
 class AssemblyFormat(str, Enum):
@@ -212,83 +203,46 @@ def _linear(srgb: int) -> list:
     return [round(float(c), 6) for c in linear]
 
 
-def _material(kind: str) -> dict:
+def _material(kind: str):
+    """The glTF material of a part kind (:data:`PART_MATERIALS`), for trimesh's exporter."""
+    from trimesh.visual.material import PBRMaterial
+
     colour, opacity, metalness = PART_MATERIALS.get(kind, PART_MATERIALS["part"])
-    material = {"name": kind,
-                "pbrMetallicRoughness": {"baseColorFactor": _linear(colour) + [opacity],
-                                         "metallicFactor": metalness, "roughnessFactor": 0.6}}
-    if opacity < 1.0:
-        # see-through: blended, and both sides drawn so the inner walls show
-        material.update(alphaMode="BLEND", doubleSided=True)
-    return material
+    rgba = [round(255 * c) for c in _linear(colour)] + [round(255 * opacity)]
+    see_through = opacity < 1.0   # blended, and both sides drawn so the inner walls show
+    return PBRMaterial(name=kind, baseColorFactor=rgba, metallicFactor=metalness,
+                       roughnessFactor=0.6, alphaMode="BLEND" if see_through else None,
+                       doubleSided=see_through)
 
 
 def _glb(parts) -> bytes:
-    """Binary glTF 2.0 of checked parts, in metres (see the module notes)."""
-    tree = {"asset": {"version": "2.0", "generator": "cadgen"}, "scene": 0,
-            "scenes": [{"name": "assembly", "nodes": []}], "nodes": [], "meshes": [],
-            "materials": [], "accessors": [], "bufferViews": [], "buffers": []}
-    chunks, length = [], 0
-    materials, meshes = {}, {}
+    """Binary glTF 2.0 of checked parts, in metres (see the module notes), by trimesh."""
+    import trimesh
+    from trimesh.exchange.gltf import export_glb
 
-    def view(data: np.ndarray, target: int) -> int:
-        nonlocal length
-        payload = data.tobytes()
-        tree["bufferViews"].append({"buffer": 0, "byteOffset": length, "byteLength": len(payload),
-                                    "target": target})
-        # every view starts on 4 bytes, so each accessor is aligned to its component size
-        payload += b"\0" * (-len(payload) % 4)
-        chunks.append(payload)
-        length += len(payload)
-        return len(tree["bufferViews"]) - 1
-
-    def accessor(data: np.ndarray, kind: str, component: int, target: int, bounds=False) -> int:
-        entry = {"bufferView": view(data, target), "componentType": component,
-                 "count": int(len(data)), "type": kind}
-        if bounds:   # from the stored float32 values, as the spec asks
-            entry["min"] = [float(v) for v in data.min(axis=0)]
-            entry["max"] = [float(v) for v in data.max(axis=0)]
-        tree["accessors"].append(entry)
-        return len(tree["accessors"]) - 1
-
+    scene = trimesh.Scene()
+    shared = {}   # one geometry per distinct (kind, mesh): a part both arms use, stored once
     for name, mesh, transform, kind in parts:
-        if kind not in materials:
-            tree["materials"].append(_material(kind))
-            materials[kind] = len(tree["materials"]) - 1
-        vertices = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
-        faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
-        if len(faces) == 0:
+        if len(mesh.faces) == 0:
             raise SolidInputError("parts", f"part {name!r} has no faces")
-        key = hashlib.sha256(kind.encode() + b"\0" + vertices.tobytes() + faces.tobytes()).digest()
-        if key not in meshes:
-            positions, normals, triangles = _shaded(mesh)
-            primitive = {
-                "attributes": {
-                    "POSITION": accessor((positions * GLTF_METRES_PER_MM).astype("<f4"), "VEC3",
-                                         _FLOAT, _ARRAY_BUFFER, bounds=True),
-                    "NORMAL": accessor(normals.astype("<f4"), "VEC3", _FLOAT, _ARRAY_BUFFER)},
-                # 16-bit indices when they fit (65535 is the restart value: below it)
-                "indices": accessor(triangles.ravel().astype("<u2"), "SCALAR", _UINT16,
-                                    _ELEMENT_ARRAY_BUFFER) if len(positions) < 65535 else
-                accessor(triangles.ravel().astype("<u4"), "SCALAR", _UINT32, _ELEMENT_ARRAY_BUFFER),
-                "material": materials[kind], "mode": _TRIANGLES}
-            tree["meshes"].append({"name": name, "primitives": [primitive]})
-            meshes[key] = len(tree["meshes"]) - 1
-        node = {"name": name, "mesh": meshes[key]}
-        if not np.array_equal(transform, np.eye(4)):
-            placed = transform.copy()
-            placed[:3, 3] *= GLTF_METRES_PER_MM
-            node["matrix"] = [float(v) for v in placed.T.ravel()]   # column-major
-        tree["nodes"].append(node)
-        tree["scenes"][0]["nodes"].append(len(tree["nodes"]) - 1)
-    tree["buffers"].append({"byteLength": length})
-    content = json.dumps(tree, separators=(",", ":"), allow_nan=False).encode("utf-8")
-    content += b" " * (-len(content) % 4)
-    binary = b"".join(chunks)   # padded to 4 bytes view by view
-    total = 12 + 8 + len(content) + 8 + len(binary)
-    return b"".join([struct.pack("<III", _GLB_MAGIC, 2, total),
-                     struct.pack("<II", len(content), _GLB_JSON), content,
-                     struct.pack("<II", len(binary), _GLB_BIN), binary])
+        placed = np.array(transform, dtype=float)
+        placed[:3, 3] *= GLTF_METRES_PER_MM
+        key = hashlib.sha256(kind.encode() + b"\0" + np.ascontiguousarray(mesh.vertices).tobytes()
+                             + np.ascontiguousarray(mesh.faces).tobytes()).digest()
+        if key in shared:
+            scene.graph.update(frame_to=name, frame_from=scene.graph.base_frame,
+                               geometry=shared[key], matrix=placed)
+            continue
+        # vertices split where faces meet at more than the crease angle, each corner's normal
+        # from its own smooth neighbourhood only (trimesh's smoothing groups let a normal
+        # lean up to 80 deg from its face at a cone's tip)
+        positions, normals, triangles = _shaded(mesh)
+        shaded = trimesh.Trimesh(positions * GLTF_METRES_PER_MM, triangles,
+                                 vertex_normals=normals, process=False)
+        shaded.visual = trimesh.visual.TextureVisuals(material=_material(kind))
+        scene.add_geometry(shaded, node_name=name, geom_name=name, transform=placed)
+        shared[key] = name
+    return export_glb(scene, include_normals=True)
 
 
 def _three_mf_writer():
