@@ -27,3 +27,23 @@ def paper_mechanism(paper_curve):
 @pytest.fixture
 def rng():
     return np.random.default_rng(20261121)
+
+
+@pytest.fixture(scope="session")
+def planting_solids():
+    """The paper's design with every solid: (params, mechanism, evaluation, cam, train,
+    assembly, housings, layout). Built once for the solids and mesh-export tests."""
+    from cadgen.cam.design import design_cam
+    from cadgen.design import build_mechanism, evaluate
+    from cadgen.gears.trains import planting_train
+    from cadgen.params import load_params
+    from cadgen.solids.planting import planting_assembly
+
+    params = load_params(REPO / "params" / "xin2024-planter.toml")
+    mechanism = build_mechanism(params)
+    evaluation = evaluate(params, mechanism, steps=720)
+    cam = design_cam(params, mechanism, evaluation.events)
+    train = planting_train(params, mechanism)
+    assembly, housings, layout = planting_assembly(params, mechanism, train, cam,
+                                                   evaluation.events.soil_level)
+    return params, mechanism, evaluation, cam, train, assembly, housings, layout

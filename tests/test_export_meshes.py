@@ -19,14 +19,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from cadgen.design import build_mechanism, evaluate
-from cadgen.cam.design import design_cam
 from cadgen.export.meshes import assembly_bytes, write_solids
-from cadgen.gears.trains import planting_train
 from cadgen.params import validate_text
 from cadgen.solids.extrude import to_trimesh
 from cadgen.solids.outcome import printing_pose, solids_outcome, solids_report
-from cadgen.solids.planting import planting_assembly
 
 from helpers import reference_text
 
@@ -45,14 +41,8 @@ def _params(build_volume=None):
 
 
 @pytest.fixture(scope="module")
-def planting():
-    params = _params()
-    mechanism = build_mechanism(params)
-    evaluation = evaluate(params, mechanism, steps=360)
-    cam = design_cam(params, mechanism, evaluation.events)
-    train = planting_train(params, mechanism)
-    assembly, housings, _ = planting_assembly(params, mechanism, train, cam,
-                                              evaluation.events.soil_level)
+def planting(planting_solids):
+    params, _, _, _, _, assembly, housings, _ = planting_solids
     outcome = solids_outcome(params, assembly, {"gearbox1": housings[0], "gearbox2": housings[1]})
     return params, outcome
 

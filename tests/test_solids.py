@@ -13,14 +13,12 @@ import math
 import numpy as np
 import pytest
 
-from cadgen.cam.design import design_cam
-from cadgen.design import build_mechanism, evaluate, pricking_design, pricking_field
-from cadgen.gears.trains import planting_train, pricking_train
+from cadgen.design import pricking_design, pricking_field
+from cadgen.export.meshes import assembly_bytes, load_volume, stl_bytes
+from cadgen.gears.trains import pricking_train
 from cadgen.params import ParameterError, load_params, validate_text
 from cadgen.params.planting import Gearbox2Envelope
-from cadgen.export.meshes import load_volume
 from cadgen.solids import encloses
-from cadgen.export.meshes import assembly_bytes, stl_bytes
 from cadgen.solids.outline import signed_area
 from cadgen.solids.parts import gear_solid
 from cadgen.solids.planting import planting_assembly
@@ -34,15 +32,8 @@ KERNEL_B = REFERENCE.parent / "kernel-b.toml"
 
 
 @pytest.fixture(scope="module")
-def planting():
-    params = load_params(REFERENCE)
-    mechanism = build_mechanism(params)
-    evaluation = evaluate(params, mechanism, steps=720)
-    cam = design_cam(params, mechanism, evaluation.events)
-    train = planting_train(params, mechanism)
-    assembly, housings, layout = planting_assembly(params, mechanism, train, cam,
-                                                   evaluation.events.soil_level)
-    return params, mechanism, evaluation, cam, train, assembly, housings, layout
+def planting(planting_solids):
+    return planting_solids
 
 
 @pytest.fixture(scope="module")

@@ -20,6 +20,7 @@ from cadgen.gears.circular import circular_module, planting_circular_radii
 
 __all__ = ["ShellSize", "planting_shells", "housing_circles", "envelope_circles"]
 
+
 @dataclass(frozen=True)
 class ShellSize:
     """One housing's dimensions (mm) and the module they were derived from."""
