@@ -47,10 +47,29 @@ def _circle_report(teeth: int) -> dict:
     return report
 
 
-def test_the_limit_is_the_hand_calculation():
-    assert MIN_ROOT_THICKNESS * MODULE == pytest.approx(LIMIT_MM)
-    # both circle gears below are undercut by the rack: fewer than 2 / sin^2(20 deg) teeth
-    assert 8 < 2 / math.sin(math.radians(20)) ** 2
+def _neck_by_arcs(teeth: int) -> float:
+    """A second method for the undercut neck: the narrowest arc width of one tooth inside the
+    cut outline (shapely), over radii from one module below the pitch circle up to it."""
+    import numpy as np
+    import shapely
+
+    radius = teeth * MODULE / 2
+    pair = circle_pair(("pinion", "wheel"), radius, 3 * radius)
+    profile = generate_pair(pair, (teeth, 3 * teeth), system=ToothSystem(MODULE)).profiles[0]
+    outline = shapely.Polygon(profile.outline - np.asarray(profile.centre))
+    turn = np.linspace(0.0, 2 * np.pi, 4000)
+    widths = [shapely.LineString(r * np.c_[np.cos(turn), np.sin(turn)]).intersection(outline).length
+              / teeth for r in np.linspace(radius - MODULE, radius, 200)]
+    return float(min(widths))
+
+
+def test_the_limit_is_the_stated_policy_and_the_neck_is_measured_right():
+    assert MIN_ROOT_THICKNESS * MODULE == pytest.approx(LIMIT_MM)   # 1.25 modules (README)
+    for teeth in (7, 8):   # both undercut by the rack: fewer than 2 / sin^2(20 deg) = 17.1 teeth
+        measured = _circle_report(teeth)["gear_train"]["gears"][0]
+        by_arcs = _neck_by_arcs(teeth)
+        assert measured["undercut_root_thickness_min_mm"] == pytest.approx(by_arcs, abs=0.05)
+        assert (by_arcs < LIMIT_MM) is (teeth == 7)
 
 
 @pytest.mark.parametrize("teeth, fails", [(8, False), (7, True)], ids=["z8-above", "z7-below"])
