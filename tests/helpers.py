@@ -17,3 +17,20 @@ def edited(**changes) -> str:
         text, count = re.subn(rf"(?m)^{re.escape(key)}\s*=\s*[^#\n]*", f"{key} = {value} ", text)
         assert count == 1, f"key {key!r} not found exactly once in the reference file"
     return text
+
+
+def with_keys(text: str, table: str, **keys) -> str:
+    """``text`` with ``key = value`` set in ``[table]``: a key already there is replaced, a
+    missing one added under the header, a missing table appended (values are TOML text)."""
+    header = re.search(rf"(?m)^\[{re.escape(table)}\][^\n]*\n", text)
+    if header is None:
+        return text + f"\n[{table}]\n" + "".join(f"{k} = {v}\n" for k, v in keys.items())
+    start = header.end()
+    following = re.search(r"(?m)^\[", text[start:])
+    end = start + following.start() if following else len(text)
+    body = text[start:end]
+    for key, value in keys.items():
+        body, count = re.subn(rf"(?m)^{re.escape(key)}\s*=\s*[^#\n]*", f"{key} = {value} ", body)
+        if not count:
+            body = f"{key} = {value}\n" + body
+    return text[:start] + body + text[end:]

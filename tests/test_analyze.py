@@ -28,7 +28,9 @@ def test_writes_report_and_plots(params, tmp_path):
     assert (folder / "cam.dxf").is_file()
     solids = sorted(p.name for p in (folder / "solids").iterdir())
     assert solids == sorted(["assembly.glb", "blade-left.stl", "blade-right.stl", "cam.stl",
-                             "central.stl", "gear-D.stl", "gearbox1.stl", "gearbox2.stl",
+                             "central.stl", "gear-D.stl", "gearbox1-base.stl",
+                             "gearbox1-cover.stl", "gearbox2-base.stl", "gearbox2-cover.stl",
+                             *(f"shaft-{axis}.stl" for axis in ("O", "A", "B", "C", "C2", "D", "E")),
                              "ground.stl", "idler-1.stl", "idler-2.stl", "intermediate.stl",
                              "planet-gear-E.stl", "planter-shell.stl", "sun.stl",
                              "train-1-planet.stl"])

@@ -25,11 +25,12 @@ def params():
 @pytest.mark.parametrize("effects, stages", [
     (["metrics"], ["kinematics", "metrics"]),
     (["curves"], ["kinematics"]),
-    (["teeth"], ["kinematics", "teeth"]),
+    (["teeth"], ["kinematics", "drivetrain", "teeth"]),
     (["cam"], ["kinematics", "metrics", "cam"]),
     (["dxf"], ["kinematics", "metrics", "cam", "teeth"]),
-    (["arm_interference"], ["kinematics", "metrics", "cam", "parts", "arm_interference"]),
-    (["ground_clearance"], ["kinematics", "metrics", "parts", "ground_clearance"]),
+    (["arm_interference"], ["kinematics", "metrics", "cam", "drivetrain", "parts",
+                            "arm_interference"]),
+    (["ground_clearance"], ["kinematics", "metrics", "drivetrain", "parts", "ground_clearance"]),
     (["plots"], ["kinematics", "plots"]),
 ])
 def test_each_effect_needs_exactly_its_stages(effects, stages):
@@ -163,7 +164,8 @@ def test_sweeps_replace_the_kinematic_estimates_and_keep_them_beside(params):
     assert ground["kinematic_estimate_mm"] - 0.03 < ground["minimum_mm"] <= \
         ground["kinematic_estimate_mm"] + 1e-6
     assert [s["stage"] for s in report["stages"]] == [
-        "kinematics", "metrics", "cam", "parts", "arm_interference", "ground_clearance"]
+        "kinematics", "metrics", "cam", "drivetrain", "parts", "arm_interference",
+        "ground_clearance"]
 
 
 def test_figures_drawn_in_a_forked_worker_are_the_same_bytes(params):

@@ -296,7 +296,8 @@ def test_keyboard_interrupt_during_a_real_build_leaves_no_folder(tmp_path, monke
     lines = capsys.readouterr().err.splitlines()
     assert lines[-1] == "cadgen: interrupted"
     assert [line.split("] ", 1)[1] for line in lines[:-1] if "started" in line] == [
-        "kinematics: started", "metrics: started", "cam: started", "parts: started"]
+        "kinematics: started", "metrics: started", "cam: started", "drivetrain: started",
+        "parts: started"]
     assert all(line.startswith("[") for line in lines[:-1])
     assert sorted(p.name for p in out.iterdir()) == ["xin2024-planter"]
     assert (out / "xin2024-planter" / "previous.txt").read_text() == "kept"

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from cadgen.export.meshes import assembly_bytes, write_solids
+from cadgen.export.meshes import assembly_bytes, material_key, write_solids
 from cadgen.params import validate_text
 from cadgen.solids.extrude import to_trimesh
 from cadgen.solids.outcome import printing_pose, solids_outcome, solids_report
@@ -30,14 +30,19 @@ from helpers import reference_text
 GLB_ATOL_M = 1e-6
 #: STL coordinates are float32 in mm.
 STL_ATOL_MM = 1e-4
-KINDS = ("gear", "housing", "cam", "planter", "blade", "ground")
+KINDS = ("gear", "housing", "shaft", "cam", "planter", "blade", "ground")
+#: Materials: one per kind, and the housings' covers their own (see-through) one.
+MATERIALS = KINDS + ("housing-cover",)
 
 
-def _params(build_volume=None):
-    text = reference_text()
+def _params(build_volume=None, process="printed"):
+    """The reference file with its parts printed (only printed parts meet the printer's bed)."""
+    from tests.helpers import with_keys
+
+    keys = {"process": f'"{process}"'}
     if build_volume is not None:
-        text += f"\n[solids]\nbuild_volume = {list(build_volume)}\n"
-    return validate_text(text)
+        keys["build_volume"] = str([float(v) for v in build_volume])
+    return validate_text(with_keys(reference_text(), "manufacturing", **keys))
 
 
 @pytest.fixture(scope="module")
@@ -171,23 +176,26 @@ def test_glb_normals_face_out_of_the_solid(glb):
         assert (np.einsum("fc,fkc->fk", faces, corner_normals) > 0.5).all(), mesh["name"]
 
 
-def test_glb_materials_differ_by_part_kind_and_housings_are_translucent(planting, glb):
+def test_glb_materials_differ_by_part_kind_and_housing_covers_are_translucent(planting, glb):
     _, outcome = planting
     tree, _ = _glb_chunks(glb)
-    kind_of = {name: part.kind for name, part, _ in outcome.assembly.placements(outcome.carrier_angle)}
+    kind_of = {name: material_key(name, part.kind)
+               for name, part, _ in outcome.assembly.placements(outcome.carrier_angle)}
+    assert kind_of["gearbox2-cover-arm1"] == "housing-cover" == kind_of["gearbox1-cover"]
+    assert kind_of["gearbox2-base-arm1"] == "housing"
     material_of_kind = {}
     for node in tree["nodes"]:
         material = tree["meshes"][node["mesh"]]["primitives"][0]["material"]
         material_of_kind.setdefault(kind_of[node["name"]], set()).add(material)
-    assert set(material_of_kind) == set(KINDS)
+    assert set(material_of_kind) == set(MATERIALS)
     assert all(len(found) == 1 for found in material_of_kind.values())    # one per kind
     chosen = {kind: tree["materials"][found.pop()] for kind, found in material_of_kind.items()}
     colours = {tuple(m["pbrMetallicRoughness"]["baseColorFactor"]) for m in chosen.values()}
-    assert len(colours) == len(KINDS)                                     # all different
+    assert len(colours) == len(MATERIALS)                                 # all different
     for kind, material in chosen.items():
         colour = material["pbrMetallicRoughness"]["baseColorFactor"]
         assert len(colour) == 4 and all(0 <= c <= 1 for c in colour)
-        if kind in ("housing", "ground"):
+        if kind in ("housing-cover", "ground"):
             assert material["alphaMode"] == "BLEND" and colour[3] < 1
         else:
             assert material.get("alphaMode", "OPAQUE") == "OPAQUE" and colour[3] == 1
@@ -252,7 +260,7 @@ def test_each_stl_is_its_part_moved_rigidly(planting, written):
             assert own[:, 2].min() > 50.0          # far above the bed where it was built
     moved = [p.name for p in outcome.assembly.parts
              if not np.allclose(outcome.printing_pose(p), np.eye(4))]
-    assert {"blade-left", "blade-right", "planter-shell", "cam", "gearbox2"} <= set(moved)
+    assert {"blade-left", "blade-right", "planter-shell", "cam", "gearbox2-base"} <= set(moved)
 
 
 def test_printing_pose_skips_a_large_face_the_part_cannot_rest_on():
@@ -290,48 +298,53 @@ def test_printing_pose_of_a_turned_box_puts_its_largest_face_down(angle):
 
 def test_parts_too_big_for_the_build_volume_are_listed(planting, written):
     params, outcome = planting
-    report = solids_report(outcome)
+    # machined parts never meet a printer's bed: nothing is checked against it
+    assert params.manufacturing.process == "machined"
+    assert solids_report(outcome)["too_big_for_build_volume"] == []
+    report = solids_report(solids_outcome(_params(), outcome.assembly, outcome.housings))
     staging, _ = written
     assert report["build_volume_mm"] == [256.0, 256.0, 256.0]
-    # gearbox 1 spans both arms' side of the carrier, over half a metre
-    assert [row["part"] for row in report["too_big_for_build_volume"]] == ["gearbox1"]
-    row = report["too_big_for_build_volume"][0]
-    vertices, _ = _read_stl(staging / "solids" / "gearbox1.stl")
-    np.testing.assert_allclose(row["print_extents_mm"], np.ptp(vertices, axis=0), atol=STL_ATOL_MM)
-    assert max(row["print_extents_mm"]) > 500
+    # gearbox 1 (base and cover) spans both arms' side of the carrier, over half a metre
+    rows = report["too_big_for_build_volume"]
+    assert [row["part"] for row in rows] == ["gearbox1-base", "gearbox1-cover"]
+    for row in rows:
+        vertices, _ = _read_stl(staging / "solids" / f"{row['part']}.stl")
+        np.testing.assert_allclose(row["print_extents_mm"], np.ptp(vertices, axis=0),
+                                   atol=STL_ATOL_MM)
+        assert max(row["print_extents_mm"]) > 500
 
 
 def test_a_small_build_volume_lists_every_part_that_does_not_fit(planting, written):
     _, outcome = planting
     staging, _ = written
     small = _params(build_volume=[60, 60, 60])
-    assert small.solids.build_volume == (60.0, 60.0, 60.0)
+    assert small.manufacturing.build_volume == (60.0, 60.0, 60.0)
     report = solids_report(solids_outcome(small, outcome.assembly, outcome.housings))
     listed = {row["part"] for row in report["too_big_for_build_volume"]}
     expected = set()
     for part in outcome.assembly.parts:
-        if part.kind == "ground":
+        if part.kind in ("ground", "shaft"):   # the soil is not made, shafts are turned
             continue
         # flat side down, any turn about z: it fits when its footprint's box does
         x, y, z = np.ptp(_read_stl(staging / "solids" / f"{part.name}.stl")[0], axis=0)
         if z > 60 or max(x, y) > 60:
             expected.add(part.name)
     assert listed == expected
-    assert {"sun", "gearbox1", "gearbox2", "planter-shell"} <= listed
+    assert {"sun", "gearbox1-base", "gearbox2-base", "gearbox2-cover", "planter-shell"} <= listed
     assert "gear-D" in {r["part"] for r in report["parts"]} - listed     # 57.6 x 57.4 x 11
 
 
 def test_a_part_that_fits_only_turned_about_z_fits(planting):
     _, outcome = planting
-    extents = next(r for r in solids_report(outcome)["parts"] if r["part"] == "gearbox2")[
+    extents = next(r for r in solids_report(outcome)["parts"] if r["part"] == "gearbox2-base")[
         "print_extents_mm"]
     long, short, height = extents[0], extents[1], extents[2]
     assert long > short
     bed = _params(build_volume=[short + 1, long + 1, height + 1])
-    assert "gearbox2" not in {r["part"] for r in solids_report(solids_outcome(
+    assert "gearbox2-base" not in {r["part"] for r in solids_report(solids_outcome(
         bed, outcome.assembly, outcome.housings))["too_big_for_build_volume"]}
     bed = _params(build_volume=[short + 1, short + 1, height + 1])
-    assert "gearbox2" in {r["part"] for r in solids_report(solids_outcome(
+    assert "gearbox2-base" in {r["part"] for r in solids_report(solids_outcome(
         bed, outcome.assembly, outcome.housings))["too_big_for_build_volume"]}
 
 
@@ -350,9 +363,10 @@ def test_three_mf_declares_millimetres(planting):
 
 def test_bad_build_volumes_name_the_field():
     from cadgen.params import ParameterError
+    from tests.helpers import with_keys
 
     for value, code in (("[0, 100, 100]", "out_of_range"), ('[100, "a", 100]', "wrong_type")):
         with pytest.raises(ParameterError) as caught:
-            validate_text(reference_text() + f"\n[solids]\nbuild_volume = {value}\n")
-        assert any(p.path.startswith("solids.build_volume") and p.code == code
+            validate_text(with_keys(reference_text(), "manufacturing", build_volume=value))
+        assert any(p.path.startswith("manufacturing.build_volume") and p.code == code
                    for p in caught.value.problems)

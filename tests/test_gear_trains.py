@@ -153,10 +153,10 @@ def test_too_many_teeth_for_the_addendum_leaves_pointed_teeth():
 
 
 def test_the_file_can_ask_for_a_shaper_everywhere():
-    from tests.helpers import edited
+    from tests.helpers import edited, with_keys
     from cadgen.params import validate_text
 
-    text = edited(teeth=22) + '\n[gears]\ncutter = "shaper"\nmeshing_poses = 48\n'
+    text = with_keys(edited(teeth=22), "gears", cutter='"shaper"', meshing_poses=48)
     params = validate_text(text, check_feasibility=False)
     train = planting_train(params, build_mechanism(params))
     assert all("shaper" in g["cutter"] for g in train_report(train)["gears"])

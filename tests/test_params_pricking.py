@@ -195,7 +195,7 @@ def test_kernel_b_loads_with_the_spec_values():
 def test_the_two_examples_differ_only_in_name_points_degree_and_speed():
     a, b = load_params(KERNEL_A), load_params(KERNEL_B)
     same = {"mechanism", "linkage", "gears", "field", "resolution", "housing", "ground", "solids",
-            "scene"}
+            "machine", "manufacturing", "scene"}
     # forward speeds differ: each is set so its tip is nearly still over the ground at the bottom
     assert (a.field.forward_speed, b.field.forward_speed) == (530.0, 600.0)
     b = b.model_copy(update={"field": b.field.model_copy(update={"forward_speed": 530.0})})
@@ -217,8 +217,8 @@ def test_example_comments_name_every_quantity(path):
         assert "#" in stripped, line  # key = value lines and the point lines
         checked += 1
     # top level 2; [trajectory] 15 (points = [, 12 points, degree, sun_centre); [linkage] 1;
-    # [gears] 6; [field] 4; [resolution] 1
-    assert checked == 2 + 15 + 1 + 6 + 4 + 1
+    # [gears] 7; [field] 4; [resolution] 1; [machine] 6; [manufacturing] 2
+    assert checked == 2 + 15 + 1 + 7 + 4 + 1 + 6 + 2
     assert "mirror" in text.lower()  # the header says the spec's points are mirrored in x
     assert "assumed" in text  # the forward speed is an assumption, not the paper's
 
@@ -437,7 +437,11 @@ def test_unknown_mechanism_lists_both_kinds():
 
 def test_optional_keys_and_tables_take_the_defaults():
     params = validate_text(_with(MINIMAL, "forward_speed", "530.0"))
-    assert params == load_params(KERNEL_A)  # the example spells out every default
+    example = load_params(KERNEL_A)
+    # the example spells out every default, and widens the gears for their keys
+    assert example.gears.face_width == 20.0
+    widened = params.gears.model_copy(update={"face_width": 20.0})
+    assert params.model_copy(update={"gears": widened}) == example
 
 
 @pytest.mark.parametrize("value", ["0", "0.0", "2", "2.5", "4", "4.0"])

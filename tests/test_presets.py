@@ -19,7 +19,9 @@ def test_standard_is_the_files_defaults():
 
 
 def test_a_preset_sets_only_what_the_file_leaves_out():
-    text = reference_text() + "\n[gears]\nflank_points = 64\n"
+    from tests.helpers import with_keys
+
+    text = with_keys(reference_text(), "gears", flank_points=64)
     params = validate_text(text, check_feasibility=False)
     draft, used = apply_preset(params, "draft")
     assert draft.gears.flank_points == 64 and used["gears.flank_points"] == (64, "file")

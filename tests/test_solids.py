@@ -18,7 +18,7 @@ from cadgen.export.meshes import assembly_bytes, load_volume, stl_bytes
 from cadgen.gears.trains import pricking_train
 from cadgen.params import ParameterError, load_params, validate_text
 from cadgen.params.planting import Gearbox2Envelope
-from cadgen.solids import encloses
+from cadgen.solids.split_housing import flange_width, split_encloses
 from cadgen.solids.outline import signed_area
 from cadgen.solids.parts import gear_solid
 from cadgen.solids.planting import planting_assembly
@@ -59,8 +59,8 @@ def test_every_part_is_a_closed_positive_volume(which, request):
         assert mesh.is_watertight and mesh.is_winding_consistent, part.name
         assert mesh.volume > 0, part.name
         kinds.add(part.kind)
-    expected = ({"gear", "housing", "cam", "planter", "blade", "ground"} if which == "planting"
-                else {"gear", "housing", "rocker", "needle", "ground"})
+    expected = ({"gear", "housing", "shaft", "cam", "planter", "blade", "ground"}
+                if which == "planting" else {"gear", "housing", "shaft", "rocker", "needle", "ground"})
     assert kinds == expected
 
 
@@ -96,8 +96,11 @@ def test_planting_housings_enclose_their_gears_checked_with_booleans(planting):
             if part.kind != "gear":
                 continue
             housing = box["gearbox2" if part.body == "gearbox2" else "gearbox1"]
-            inside, outside = encloses(housing, _to_manifold(part, part.local(phi)))
+            inside, outside = split_encloses(housing, _to_manifold(part, part.local(phi)))
             assert inside, (part.name, phi, outside)
+            # and they cut neither half of the split housing
+            placed = _to_manifold(part, part.local(phi))
+            assert (placed ^ housing.base).is_empty() and (placed ^ housing.cover).is_empty()
     report = _solids_outcome(planting[0], assembly, box).enclosure
     assert all(row["gears_enclosed"] for row in report)
     assert {row["nearest_gear"] for row in report} <= {p.name for p in assembly.parts}
@@ -121,7 +124,7 @@ def test_a_housing_too_small_for_its_gears_is_reported(planting):
     assert -8.0 - 0.05 < rows["gearbox2"]["smallest_margin_mm"] < 0.0
     central = next(p for p in assembly.parts if p.name == "central")
     # and the booleans agree: at some pose the central gear pokes into the wall
-    assert any(not encloses(housings[1], _to_manifold(central, central.local(phi)))[0]
+    assert any(not split_encloses(housings[1], _to_manifold(central, central.local(phi)))[0]
                for phi in np.linspace(0, 2 * np.pi, 12, endpoint=False))
 
 
@@ -130,7 +133,7 @@ def test_pricking_case_encloses_its_gears(pricking):
     case = housings["gear-case"]
     for angle in (0.0, 2.0, 4.5):
         for part in (p for p in assembly.parts if p.kind == "gear"):
-            inside, outside = encloses(case, _to_manifold(part, part.local(angle)))
+            inside, outside = split_encloses(case, _to_manifold(part, part.local(angle)))
             assert inside, (part.name, angle, outside)
 
 
@@ -165,21 +168,54 @@ def test_blades_open_to_the_mouth_the_cam_gives(planting):
 
 
 def test_solid_housing_matches_the_kinematic_ground_clearance(planting):
-    """The housing's outline is the hull of the kinematic envelope circles (circumscribed
-    polygons: at most r (1/cos(pi/n) - 1) farther out)."""
+    """The housing's outermost edge (the parting flange) is its wall's hull of circumscribed
+    polygons offset by the flange width, and the envelope circles are the gears' discs grown by
+    clearance, wall and flange: the solid reaches at most the polygons' sag r (1/cos(pi/n) - 1)
+    beyond them and never falls inside them; its side wall stands one flange width inside."""
     params, mechanism, evaluation, *_ = planting
-    assembly = planting[5]
+    assembly, housings = planting[5], planting[6]
     phi = math.radians(evaluation.extras["ground_clearance_at_deg"])
-    lowest = np.inf
+    lowest, lowest_wall, flange = np.inf, np.inf, 0.0
     for name, part, pose in assembly.placements(phi):
         if part.kind == "housing":
             world = part.mesh.vertices @ pose[:3, :3].T + pose[:3, 3]
             lowest = min(lowest, world[:, 1].min())
-    solid_clearance = lowest - evaluation.events.soil_level
+            housing = housings[0 if name.startswith("gearbox1") else 1]
+            outline = housing.outer_outline @ pose[:2, :2].T + pose[:2, 3]
+            if outline[:, 1].min() < lowest_wall:
+                lowest_wall = outline[:, 1].min()
+                flange = flange_width(housing.bolt_hole_diameter)
     kinematic = next(m.value for m in evaluation.metrics if m.key == "ground_clearance")
     n = params.solids.segments_per_circle
     bound = max(c.radius for c in evaluation.housing_circles) * (1 / math.cos(math.pi / n) - 1)
+    solid_clearance = lowest - evaluation.events.soil_level
     assert kinematic - bound - 1e-9 <= solid_clearance <= kinematic + 1e-9
+    wall_clearance = lowest_wall - evaluation.events.soil_level
+    assert kinematic + flange - bound - 1e-9 <= wall_clearance <= kinematic + flange + 1e-9
+
+
+def test_shafts_clear_the_housings_and_the_cam_is_bored_for_e(planting):
+    """Every shaft runs in its seats and holes without touching the housing's material; side
+    instances and arm instances as the gears'; the cam's bore is E's running hole."""
+    params, mechanism, *_, assembly, housings, _ = planting
+    from cadgen.machine.drivetrain import drivetrain
+
+    machine = drivetrain(params, mechanism)
+    shafts = {p.name: p for p in assembly.parts if p.kind == "shaft"}
+    assert set(shafts) == {f"shaft-{s.name}" for s in machine.shafts}
+    assert [i[0] for i in shafts["shaft-A"].instances] == ["shaft-A-side1", "shaft-A-side2"]
+    assert [i[0] for i in shafts["shaft-E"].instances] == ["shaft-E-arm1", "shaft-E-arm2"]
+    for part in shafts.values():
+        housing = housings[1] if part.body == "gearbox2" else housings[0]
+        placed = _to_manifold(part, part.local(0.0))
+        assert (placed ^ housing.solid).volume() < 1e-6, part.name
+    e = next(s for s in machine.shafts if s.name == "E")
+    hole = next(seat.hole_diameter for seat in e.seats if seat.wall == "roof")
+    cam = next(p for p in assembly.parts if p.name == "cam")
+    n = params.solids.segments_per_circle
+    bore_area = n / 2 * (hole / 2) ** 2 * math.sin(2 * math.pi / n)
+    assert cam.mesh.volume == pytest.approx(
+        (signed_area(cam.outline) - bore_area) * params.cam.thickness, rel=1e-9)
 
 
 def test_stl_and_assembly_round_trip_with_the_same_volume(planting, tmp_path):
@@ -199,14 +235,25 @@ def test_mass_properties_against_closed_forms(planting):
     report = solids_report(_solids_outcome(params, planting[5], {
         "gearbox1": planting[6][0], "gearbox2": planting[6][1]}))
     rows = {row["part"]: row for row in report["parts"]}
-    density = params.solids.density_kg_m3 * 1e-9
+    # machined gears are steel: 7850 kg/m^3 (EN 10083 data sheet), 1e-9 kg/mm^3 per kg/m^3
+    assert params.manufacturing.process == "machined"
     for name in ("sun", "idler-1", "central"):
         row = rows[name]
-        assert row["mass_kg"] == pytest.approx(row["volume_mm3"] * density, rel=1e-12)
-    # a circular gear is symmetric about its axis: centre of mass on it, mid-face
+        assert row["material"] == "steel C45" and row["density_kg_m3"] == 7850.0
+        assert row["mass_kg"] == pytest.approx(row["volume_mm3"] * 7850.0e-9, rel=1e-12)
+    # a circular gear is symmetric about its axis but for its keyway: centre of mass mid-face,
+    # off the axis by at most the keyway's area times its reach over the section's area
+    from cadgen.design import build_mechanism
+    from cadgen.machine.drivetrain import drivetrain
+
     sun = rows["sun"]
     face = params.gears.face_width_for(1.8)
-    np.testing.assert_allclose(sun["centre_of_mass_mm"], [0.0, 0.0, face / 2], atol=1e-6)
+    _, mount = drivetrain(params, build_mechanism(params)).shaft_of_gear("sun")
+    reach = mount.hub_bore / 2 + mount.key.hub_depth
+    section = math.pi * (30.0**2 - reach**2)          # at least: the root circle minus the hole
+    bound = mount.key.width * mount.key.hub_depth * reach / section
+    assert sun["centre_of_mass_mm"][2] == pytest.approx(face / 2, abs=1e-9)
+    assert math.hypot(*sun["centre_of_mass_mm"][:2]) <= bound
     inertia = np.array(sun["inertia_kg_mm2"])
     assert inertia[0, 0] == pytest.approx(inertia[1, 1], rel=1e-6)   # axisymmetric
     # between the solid discs of the root and the tip radius: m r^2 / 2
@@ -229,12 +276,11 @@ def test_bad_solid_parameters_name_the_field(changes, path, code):
 
 def _with_keys(changes):
     """The reference file with keys added to [housing] or [gears] (added if missing)."""
+    from tests.helpers import with_keys
+
     text = reference_text()
     for key, value in changes.items():
-        table = "[housing]" if key == "wall" else "[gears]"
-        if table not in text:
-            text += f"\n{table}\n"
-        text = text.replace(table + "\n", f"{table}\n{key} = {value}\n", 1)
+        text = with_keys(text, "housing" if key == "wall" else "gears", **{key: value})
     return text
 
 

@@ -7,7 +7,9 @@ everything else is construction geometry on ``CONSTRUCTION-...`` layers whose pl
 ``OUTLINE`` (colour 7)
     The tooth outline (cam: the working profile), one closed ``LWPOLYLINE``.
 ``BORE`` (colour 1)
-    The shaft bore, a ``CIRCLE`` at the rotation centre (if the bore radius is > 0).
+    The shaft bore: a gear's hub hole (bore and keyway or D-flat, :mod:`cadgen.machine.hubs`)
+    as one closed ``LWPOLYLINE`` when its profile has a ``hole``, else a ``CIRCLE`` at the
+    rotation centre (if the bore radius is > 0; a cam's bore is always a circle).
 ``CONSTRUCTION-PITCH`` (colour 3, centre line)
     The pitch curve (cam: the roller centre's path), one *open* ``LWPOLYLINE``: its closing
     stretch (at least :data:`PITCH_CURVE_GAP`) is left out, so chaining never closes it.
@@ -22,7 +24,7 @@ every view. The header extents (``$EXTMIN``/``$EXTMAX``, ``$LIMMIN``/``$LIMMAX``
 bounding box of the entities (``ezdxf.bbox``; a ``TEXT`` as :func:`_text_box`, font-free).
 
 The dense outline is thinned by Douglas-Peucker to a chord tolerance (halved until the ring
-stays simple and clear of the bore; the tolerance used is in :class:`DxfSummary`). Every
+stays simple and clear of the disc holding the bore and its keyway; the tolerance used is in :class:`DxfSummary`). Every
 document passes ``ezdxf``'s audit and is written atomically and byte-identically for the same
 input (fixed metadata). ``ezdxf`` and ``shapely`` are imported inside the functions.
 """
@@ -144,15 +146,19 @@ def _gear_problems(profile, *, label: str | None = None) -> list[str]:
     """Every problem of one gear profile, each naming the bad value."""
     label = label or f"gear {getattr(profile, 'name', '?')!r}"
     problems = _plate_problems(profile.outline, profile.pitch_curve, profile.centre,
-                               profile.bore_radius, label)
+                               profile.bore_radius, label, hole=getattr(profile, "hole", None))
     module = profile.module
     if not (isinstance(module, (int, float, np.number)) and math.isfinite(module) and module > 0):
         problems.append(f"{label}: module must be a finite number > 0, got {module!r}")
     return problems
 
 
-def _plate_problems(outline, pitch_curve, centre, bore, label: str) -> list[str]:
-    """Problems of a cut plate (gear or cam): outline, pitch curve, centre, bore inside the outline."""
+def _plate_problems(outline, pitch_curve, centre, bore, label: str, hole=None) -> list[str]:
+    """Problems of a cut plate (gear or cam): outline, pitch curve, centre, bore inside the outline.
+
+    ``hole`` (a gear's hub hole, a closed ring) replaces the circular bore when given: it must
+    be a simple ring strictly inside the outline, touching it nowhere.
+    """
     import shapely
 
     problems = []
@@ -165,7 +171,9 @@ def _plate_problems(outline, pitch_curve, centre, bore, label: str) -> list[str]
     if centre.shape != (2,) or not np.isfinite(centre).all():
         problems.append(f"{label}: centre must be two finite numbers, got {given_centre!r}")
         return problems
-    if not (isinstance(bore, (int, float, np.number)) and math.isfinite(bore) and bore >= 0):
+    if hole is not None:
+        problems += _hole_problems(outline, hole, label, outline_problems)
+    elif not (isinstance(bore, (int, float, np.number)) and math.isfinite(bore) and bore >= 0):
         problems.append(f"{label}: bore_radius must be a finite number >= 0, got {bore!r}")
     elif bore > 0 and not outline_problems:
         ring = shapely.LinearRing(outline)
@@ -174,6 +182,23 @@ def _plate_problems(outline, pitch_curve, centre, bore, label: str) -> list[str]
         if not shapely.Polygon(ring).contains(point) or clearance <= bore:
             problems.append(f"{label}: bore (radius {bore} mm at {centre.tolist()}) is not inside the "
                             f"outline (nearest outline point {clearance:.6g} mm from the centre)")
+    return problems
+
+
+def _hole_problems(outline, hole, label: str, outline_problems) -> list[str]:
+    """Problems of a hub hole: a simple closed ring strictly inside a valid outline."""
+    import shapely
+
+    hole = closed_points(hole)
+    problems = ring_problems(f"{label}: hole", hole)
+    if problems or outline_problems:
+        return problems
+    ring, inner = shapely.LinearRing(outline), shapely.LinearRing(hole)
+    clearance = ring.distance(inner)
+    if not shapely.Polygon(ring).contains(shapely.Polygon(inner)) or clearance <= 0.0:
+        problems.append(f"{label}: hole (reaching {np.hypot(*hole.T).max():.6g} mm from the "
+                        f"origin) is not inside the outline (nearest outline point "
+                        f"{clearance:.6g} mm from it)")
     return problems
 
 
@@ -243,12 +268,16 @@ def _add_centre_mark(msp, centre, half: float) -> None:
 
 
 def _add_gear(msp, outline: np.ndarray, pitch: np.ndarray, centre: np.ndarray, bore_radius: float,
-              module: float) -> None:
-    """Add one placed gear's entities (already in sheet coordinates) to the modelspace."""
+              module: float, hole=None) -> None:
+    """Add one placed gear's entities (already in sheet coordinates) to the modelspace; its
+    ``hole`` (placed likewise) is drawn in place of the bore circle."""
     msp.add_lwpolyline(outline.tolist(), format="xy", close=True, dxfattribs={"layer": "OUTLINE"})
     msp.add_lwpolyline(open_ring(pitch, PITCH_CURVE_GAP).tolist(), format="xy", close=False,
                        dxfattribs={"layer": PITCH_LAYER})
-    if bore_radius > 0:
+    if hole is not None:
+        msp.add_lwpolyline(closed_points(hole).tolist(), format="xy", close=True,
+                           dxfattribs={"layer": "BORE"})
+    elif bore_radius > 0:
         msp.add_circle(centre.tolist(), bore_radius, dxfattribs={"layer": "BORE"})
     _add_centre_mark(msp, centre, CENTRE_MARK_HALF_LENGTH_MODULES * module)
 
@@ -305,10 +334,20 @@ def _audited_bytes(doc, path: Path) -> bytes:
 
 
 def _thin_gear(profile, outline: np.ndarray, pitch: np.ndarray, tolerance: float):
-    """Thinned outline, its tolerance, and thinned pitch curve of a validated profile (body frame)."""
-    thinned, used = thin_outline(outline, tolerance, profile.centre, profile.bore_radius)
+    """Thinned outline, its tolerance, and thinned pitch curve of a validated profile (body frame).
+
+    The outline keeps clear of the disc of the hole's reach (its keyway included); where the
+    root comes closer to the centre than that reach (a keyway turned to a non-circular gear's
+    far root) no thinning passes and the dense outline, checked clear of the hole, is kept.
+    """
+    thinned, used = thin_outline(outline, tolerance, profile.centre, _hole_reach(profile))
     thin_pitch, _ = thin_ring(pitch, tolerance)
     return thinned, used, thin_pitch
+
+
+def _hole_reach(profile) -> float:
+    """The disc the thinned outline keeps clear of (a profile without ``hole_reach``: its bore)."""
+    return float(getattr(profile, "hole_reach", profile.bore_radius))
 
 
 # --------------------------------------------------------------------------- public API
@@ -324,7 +363,8 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     profile : cadgen.gears.teeth.GearProfile
         The gear, in its body frame: ``outline`` (n, 2) and ``pitch_curve`` (m, 2)
         closed, simple, finite; ``module`` > 0; ``bore_radius`` >= 0, the bore
-        inside the outline.
+        inside the outline; or ``hole`` (the hub hole, a closed ring strictly inside
+        the outline), drawn in place of the bore circle.
     chord_tolerance : float, default 0.005
         mm, finite and > 0. The dense outline (and pitch curve) are thinned so that
         every dropped point lies within this distance of the written polyline.
@@ -344,7 +384,7 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     Notes
     -----
     Cutting layers (plotted): ``OUTLINE`` (one closed LWPOLYLINE, counter-clockwise),
-    ``BORE`` (CIRCLE, if any). Construction layers (not plotted): ``CONSTRUCTION-PITCH``
+    ``BORE`` (the hole as a closed LWPOLYLINE, else a CIRCLE, if any). Construction layers (not plotted): ``CONSTRUCTION-PITCH``
     (open LWPOLYLINE, its closing stretch of at least :data:`PITCH_CURVE_GAP` left out),
     ``CONSTRUCTION-CENTRE`` (two LINEs crossing at the centre, two modules long).
     """
@@ -357,7 +397,7 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
                                       closed_points(profile.pitch_curve), tolerance)
     doc = _new_document()
     _add_gear(doc.modelspace(), outline, pitch, np.asarray(profile.centre, dtype=float),
-              float(profile.bore_radius), float(profile.module))
+              float(profile.bore_radius), float(profile.module), getattr(profile, "hole", None))
     write_bytes_atomic(path, _audited_bytes(doc, path))
     area, perimeter = ring_measures(outline)
     return DxfSummary(path, len(outline), used, area, perimeter)

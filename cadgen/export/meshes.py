@@ -15,8 +15,10 @@ GLB
     :data:`CREASE_ANGLE_DEG` (``trimesh.graph.smooth_shade``: flat faces stay flat,
     tessellated curves shade smooth); one named node per placed part with its rigid
     transform; one geometry per distinct mesh (a part both arms use is stored
-    once); one material per part kind (:data:`PART_MATERIALS`: base colour, housings
-    and soil translucent with ``alphaMode`` BLEND). Deterministic as trimesh writes it.
+    once); one material per part kind (:data:`PART_MATERIALS`: base colour; housing
+    covers and the soil translucent with ``alphaMode`` BLEND, so the gears and shafts
+    show through the cover while the base stays solid; see :func:`material_key`).
+    Deterministic as trimesh writes it.
 3MF
     Needs ``lxml`` and ``networkx`` (trimesh's soft dependencies). trimesh fixes
     the zip timestamps (1980-01-01) but gives every object, item and the build a
@@ -49,6 +51,7 @@ __all__ = [
     "GLTF_METRES_PER_MM",
     "CREASE_ANGLE_DEG",
     "PART_MATERIALS",
+    "material_key",
     "stl_bytes",
     "assembly_bytes",
     "load_volume",
@@ -68,10 +71,14 @@ GLTF_METRES_PER_MM = 1e-3
 #: Faces meeting at more than this angle (deg) get separate vertex normals (a sharp edge).
 CREASE_ANGLE_DEG = 30.0
 #: A material per part kind: sRGB colour, opacity (below 1: alphaMode BLEND), metalness.
-#: Housings and the soil are see-through, so the gears inside them show.
+#: Housing covers and the soil are see-through, so the gears inside them show; a housing's
+#: base is opaque (one looks into it through the cover). ``"housing-cover"`` is not a part
+#: kind but the material of a housing part named ``...-cover`` (:func:`material_key`).
 PART_MATERIALS = {
     "gear": (0x7F93AA, 1.0, 0.35),
-    "housing": (0xAAB4C0, 0.3, 0.1),
+    "housing": (0xAAB4C0, 1.0, 0.1),
+    "housing-cover": (0xC4CCD6, 0.35, 0.1),
+    "shaft": (0x6E747C, 1.0, 0.8),     # turned steel: grey, metallic
     "cam": (0x6D8F3C, 1.0, 0.1),
     "planter": (0xE08A2C, 1.0, 0.1),
     "blade": (0xC8432B, 1.0, 0.2),
@@ -203,6 +210,18 @@ def _linear(srgb: int) -> list:
     return [round(float(c), 6) for c in linear]
 
 
+def material_key(name: str, kind: str) -> str:
+    """The :data:`PART_MATERIALS` key of a placed part: its kind, except a housing's cover.
+
+    A split housing's base and cover are both of kind ``"housing"`` (one made part
+    family: same material, same process); only the cover is drawn see-through, told
+    by its name (``gearbox2-cover``, ``gearbox2-cover-arm1``, ``gear-case-cover``).
+    """
+    if kind == "housing" and re.search(r"-cover(-|$)", name):
+        return "housing-cover"
+    return kind
+
+
 def _material(kind: str):
     """The glTF material of a part kind (:data:`PART_MATERIALS`), for trimesh's exporter."""
     from trimesh.visual.material import PBRMaterial
@@ -227,7 +246,8 @@ def _glb(parts) -> bytes:
             raise SolidInputError("parts", f"part {name!r} has no faces")
         placed = np.array(transform, dtype=float)
         placed[:3, 3] *= GLTF_METRES_PER_MM
-        key = hashlib.sha256(kind.encode() + b"\0" + np.ascontiguousarray(mesh.vertices).tobytes()
+        material = material_key(name, kind)
+        key = hashlib.sha256(material.encode() + b"\0" + np.ascontiguousarray(mesh.vertices).tobytes()
                              + np.ascontiguousarray(mesh.faces).tobytes()).digest()
         if key in shared:
             scene.graph.update(frame_to=name, frame_from=scene.graph.base_frame,
@@ -239,7 +259,7 @@ def _glb(parts) -> bytes:
         positions, normals, triangles = _shaded(mesh)
         shaded = trimesh.Trimesh(positions * GLTF_METRES_PER_MM, triangles,
                                  vertex_normals=normals, process=False)
-        shaded.visual = trimesh.visual.TextureVisuals(material=_material(kind))
+        shaded.visual = trimesh.visual.TextureVisuals(material=_material(material))
         scene.add_geometry(shaded, node_name=name, geom_name=name, transform=placed)
         shared[key] = name
     return export_glb(scene, include_normals=True)

@@ -20,7 +20,7 @@ from cadgen.export.dxf import (CENTRE_MARK_HALF_LENGTH_MODULES, LABEL_GAP_MODULE
                                TEXT_WIDTH_PER_CHARACTER, VIEW_GAP_FRACTION, VIEW_GAP_MIN,
                                VIEW_SHIFT_STEP, DxfInputError, DxfSummary, _add_centre_mark,
                                _add_gear, _add_label, _audited_bytes, _check_tolerance, _finite,
-                               _gear_problems, _new_document, _text_box, _thin_gear,
+                               _gear_problems, _hole_reach, _new_document, _text_box, _thin_gear,
                                write_gear_dxf)
 from cadgen.geometry.contour import closed_points, ring_measures
 
@@ -109,8 +109,12 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
         rotation = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
         centre = np.asarray(profile.centre, dtype=float)
         move = np.asarray(offset, dtype=float)
+        hole = getattr(profile, "hole", None)
+        if hole is not None:  # the hub hole turns with its gear
+            hole = (closed_points(hole) - centre) @ rotation.T + centre + move
         gears.append(_PlacedGear(profile, plane, (outline - centre) @ rotation.T + centre + move,
-                                 (pitch - centre) @ rotation.T + centre + move, centre + move))
+                                 (pitch - centre) @ rotation.T + centre + move, centre + move,
+                                 hole))
         area, perimeter = ring_measures(outline)
         summaries.append(DxfSummary(path, len(outline), used, area, perimeter))
     _draw_views(doc.modelspace(), gears, float(label_height))
@@ -125,6 +129,7 @@ class _PlacedGear:
     outline: np.ndarray   # (n, 2) in train coordinates
     pitch: np.ndarray     # (m, 2)
     centre: np.ndarray    # (2,)
+    hole: np.ndarray | None = None   # (k, 2) the hub hole, placed; None: the bore circle
 
 
 def _shares_axis(first, second) -> bool:
@@ -155,12 +160,12 @@ def _sheet_planes(placements, planes) -> tuple[list, list[str]]:
 
 
 def _label_anchor(gear: _PlacedGear, height: float) -> np.ndarray:
-    """Inside the gear under its centre mark (or bore), else above it, where the label fits;
+    """Inside the gear under its centre mark (or bore and keyway), else above it, where the label fits;
     else below the gear."""
     import shapely
 
     module = float(gear.profile.module)
-    clear = max(float(gear.profile.bore_radius), CENTRE_MARK_HALF_LENGTH_MODULES * module) + module
+    clear = max(_hole_reach(gear.profile), CENTRE_MARK_HALF_LENGTH_MODULES * module) + module
     body = shapely.Polygon(gear.outline)
     for anchor in (gear.centre - [0.0, clear], gear.centre + [0.0, clear + TEXT_BOX_DEPTH * height]):
         (x0, y0), (x1, y1) = _text_box(anchor, gear.profile.name, height)
@@ -201,7 +206,8 @@ def _draw_views(msp, gears: list, label_height: float) -> None:
         move = np.array([shift, 0.0])
         for gear, anchor in zip(members, anchors):
             _add_gear(msp, gear.outline + move, gear.pitch + move, gear.centre + move,
-                      float(gear.profile.bore_radius), float(gear.profile.module))
+                      float(gear.profile.bore_radius), float(gear.profile.module),
+                      None if gear.hole is None else gear.hole + move)
             _add_label(msp, anchor + move, gear.profile.name, label_height)
         for centre, half in axes:
             if not any(_shares_axis(centre, gear.centre) for gear in members):

@@ -457,6 +457,10 @@ class GearProfile:
         Radius of the shaft bore at the body-frame origin (mm); 0 for none.
     centre : (2,) float
         Rotation centre in the body frame (the origin, normally).
+    hole : (k, 2) float, optional
+        The hub's hole in the body frame (the bore with its keyway or D-flat, closed,
+        counter-clockwise, the first point not repeated; see :mod:`cadgen.machine.hubs`).
+        When set it is what is cut, in place of the circle of ``bore_radius``.
     """
 
     name: str
@@ -467,6 +471,16 @@ class GearProfile:
     bore_radius: float = 0.0
     centre: tuple = (0.0, 0.0)
     notes: dict = field(default_factory=dict)
+    hole: np.ndarray | None = None
+
+    @property
+    def hole_reach(self) -> float:
+        """mm, the farthest the hole (or the round bore) reaches from the centre: a disc of
+        this radius holds everything cut at the hub (the outline's thinning keeps clear of it)."""
+        if self.hole is None:
+            return float(self.bore_radius)
+        offsets = np.asarray(self.hole, dtype=float) - np.asarray(self.centre, dtype=float)
+        return float(np.max(np.hypot(offsets[:, 0], offsets[:, 1])))
 
     @property
     def file_stem(self) -> str:

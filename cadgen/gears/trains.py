@@ -40,6 +40,7 @@ class GearStage:
 class GearTrain:
     stages: tuple
     failures: tuple = ()   # (stage name, Problem) for stages whose gears cannot be cut
+    rims: tuple = ()       # cadgen.machine.hubs.RimCheck per gear, once bored for its shaft
 
     @property
     def gears(self):
@@ -57,7 +58,7 @@ class GearTrain:
 def _system(cutting, module) -> ToothSystem:
     return ToothSystem(module, pressure_angle=cutting.pressure_angle_rad, addendum=cutting.addendum,
                        dedendum=cutting.dedendum, tip_radius=cutting.tip_radius,
-                       backlash=cutting.backlash)
+                       backlash=cutting.backlash if cutting.backlash is not None else 0.0)
 
 
 #: Poses of the meshing check over one tooth pitch of a circular pair.

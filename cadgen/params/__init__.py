@@ -5,11 +5,12 @@ A parameter file names its mechanism kind and holds one table per part of the de
 * ``mechanism = "planting"`` (kind 1, :class:`PlantingParameters`): the differential
   planetary planting mechanism, tables ``[pitch_curve]``, ``[train]``, ``[planter]``,
   ``[field]`` and the optional ``[housing]``, ``[targets]``, ``[resolution]``, ``[gears]``,
-  ``[cam]``, ``[ground]``, ``[solids]``;
+  ``[cam]``, ``[ground]``, ``[solids]``, ``[machine]``, ``[manufacturing]``;
 * ``mechanism = "pricking"`` (kind 2, :class:`PrickingParameters`): the inclined
   hole-pricking mechanism, inverse-designed from its needle-tip loop, tables
   ``[trajectory]``, ``[linkage]``, ``[field]`` and the optional ``[gears]``,
-  ``[resolution]``, ``[housing]``, ``[ground]``, ``[solids]``. Only the structure of the
+  ``[resolution]``, ``[housing]``, ``[ground]``, ``[solids]``, ``[machine]``,
+  ``[manufacturing]``. Only the structure of the
   type-value points is checked here (at least 5 pairs of finite numbers); their geometry
   (repeated points, self-intersection, the sun centre inside the loop) is the kinematic
   model's to judge.
@@ -120,6 +121,8 @@ from cadgen.params.pricking import (
 from cadgen.params.cam import CamParameters, CamTimingParameters, DuckbillParameters, LeverParameters
 from cadgen.params.cutting import CuttingParameters
 from cadgen.params.solids import MIN_WALL, GroundParameters, ShellParameters, SolidsParameters
+from cadgen.params.machine import (DEFAULT_BUILD_VOLUME, PROCESSES, MachineParameters,
+                                   ManufacturingParameters, ShaftDiameters)
 
 __all__ = [
     "ParameterError",
@@ -149,6 +152,11 @@ __all__ = [
     "ShellParameters",
     "GroundParameters",
     "SolidsParameters",
+    "MachineParameters",
+    "ManufacturingParameters",
+    "ShaftDiameters",
+    "PROCESSES",
+    "DEFAULT_BUILD_VOLUME",
     "MIN_WALL",
     "DesignParameters",
     "MECHANISM_KINDS",

@@ -66,7 +66,10 @@ class CamParameters(_Table):
     return_law: MotionLaw = Field("cycloidal", description='closing law: "cycloidal" or "polynomial-345"')
     max_pressure_angle_deg: float = Field(30.0, gt=0, lt=90, description="pressure angle limit, deg")
     thickness: float = Field(8.0, gt=0, description="cam plate thickness, mm")
-    bore_diameter: float = Field(12.0, ge=0, description="cam bore on the E shaft, mm")
+    bore_diameter: float | None = Field(
+        None, gt=0, description="cam bore round the E shaft, mm (default: the E shaft's "
+                                "diameter plus the process's running clearance; the cam is "
+                                "fixed to gearbox 2 and the shaft turns inside it)")
     profile_points: int = Field(3600, ge=360, le=1_000_000,
                                 description="cam-angle samples of the contour before DXF thinning")
     duckbill: DuckbillParameters = DuckbillParameters()

@@ -24,8 +24,9 @@ class CuttingParameters(_Table):
     dedendum: float = Field(1.25, gt=0, le=2.5, description="dedendum coefficient hf*, dimensionless")
     tip_radius: float = Field(0.38, ge=0, le=0.6,
                               description="cutter tip radius (root fillet), coefficient of the module")
-    backlash: float = Field(0.0, ge=0, le=2,
-                            description="circumferential backlash taken off each gear's teeth, mm")
+    backlash: float | None = Field(
+        None, ge=0, le=2, description="circumferential backlash taken off each gear's teeth, mm "
+                                      "(default: the [manufacturing] process's allowance)")
     flank_points: int = Field(96, ge=8, le=4000, description="points per generated flank")
     chord_tolerance: float = Field(0.005, gt=0, le=1,
                                    description="largest deviation of the DXF polyline from the profile, mm")

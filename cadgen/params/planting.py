@@ -18,6 +18,7 @@ from cadgen.params.cam import CamParameters
 from cadgen.params.cutting import CuttingParameters
 from cadgen.params.scene import SceneParameters
 from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
+from cadgen.params.machine import MachineParameters, ManufacturingParameters
 from cadgen.params._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -222,4 +223,6 @@ class PlantingParameters(_Table):
     cam: CamParameters = CamParameters()
     ground: GroundParameters = GroundParameters()
     solids: SolidsParameters = SolidsParameters()
+    machine: MachineParameters = MachineParameters()
+    manufacturing: ManufacturingParameters = ManufacturingParameters()
     scene: SceneParameters = SceneParameters()

@@ -4,24 +4,20 @@
 each may be left out and is then derived from the module of the gears the housing
 encloses. ``[ground]`` is the soil surface as a mesh (flat or a ridge). ``[solids]``
 holds the mesh resolution, the density for the mass properties and the pose of
-the assembly file, and the printer's build volume the printed parts are checked against.
+the assembly file (the printer's build volume is ``[manufacturing]``'s).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Literal
 
-from pydantic import BeforeValidator, Field, field_validator
+from pydantic import Field, field_validator
 from pydantic_core import PydanticCustomError
 
-from cadgen.params._tables import _list_to_tuple, _Table
+from cadgen.params._tables import _Table
 
-__all__ = ["MIN_WALL", "DEFAULT_BUILD_VOLUME", "ShellParameters", "GroundParameters",
-           "SolidsParameters"]
-
-#: A common printer bed (x, y, z in mm): 256 mm cube printers are widespread.
-DEFAULT_BUILD_VOLUME = (256.0, 256.0, 256.0)
+__all__ = ["MIN_WALL", "ShellParameters", "GroundParameters", "SolidsParameters"]
 
 #: The thinnest housing wall accepted (mm): thinner cast or welded walls do not hold a bearing.
 MIN_WALL = 2.0
@@ -38,6 +34,9 @@ class ShellParameters(_Table):
                           f"at least {MIN_WALL:g} mm)")
     axial_gap: float = Field(2.0, ge=0, description="between gear layers and the housing's inner "
                                                     "faces, mm")
+    bolt_size: Literal["M3", "M4", "M5", "M6", "M8", "M10"] | None = Field(
+        None, description="ISO metric bolts joining each housing's base and cover (default: from "
+                          "the wall: M3 below 4 mm, M4 below 6 mm, M5 below 8 mm, else M6)")
 
     @field_validator("wall")
     @classmethod
@@ -76,17 +75,12 @@ class SolidsParameters(_Table):
 
     segments_per_circle: int = Field(96, ge=8, le=4096,
                                      description="facets of a full circle (bores, shells, tubes)")
-    density_kg_m3: float = Field(7850.0, gt=0, description="density for the mass properties, kg/m^3")
+    density_kg_m3: float | None = Field(
+        None, gt=0, description="density of every made part for the mass properties, kg/m^3 "
+                                "(default: each part's material, from [manufacturing] process)")
     assembly_carrier_angle_deg: float = Field(0.0, description="carrier angle of the assembly file, "
                                                                "deg (0 = catching)")
     assembly_format: Literal["glb", "3mf"] = Field("glb", description='"glb" or "3mf"')
-    build_volume: Annotated[
-        tuple[Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)],
-              Annotated[float, Field(gt=0)]],
-        BeforeValidator(_list_to_tuple)] = Field(
-        DEFAULT_BUILD_VOLUME,
-        description="printer build volume [x, y, z], mm: every part's printing pose (largest "
-                    "flat face down, turned 90 deg about z if that fits) is checked against it")
 
     @property
     def assembly_carrier_angle_rad(self) -> float:

@@ -11,10 +11,15 @@ Stages (each timed and recorded ``ok``, ``failed`` with the reason, or
 ==================  ==========================================================
 kinematics          the mechanism (planting: closure; pricking: inverse design)
 metrics             the design metrics (planting) or the field motion (pricking)
-teeth               every gear cut, checked and run through its meshing check
+drivetrain          shafts from torque, catalogue bearings (L10 life), keys, fits
+                    (:mod:`cadgen.machine`): numbers only, no solids
+teeth               every gear cut, checked and run through its meshing check,
+                    each bored for its shaft with its keyway (rim check)
 cam                 the duckbill cam (planting)
-parts               the solids: housings, planter or needle, ground; gears and
-                    the cam plate when those ran; mass and enclosure checks
+parts               the solids: split housings (base and cover with bearing
+                    seats and bolt flanges), shafts, planter or needle, ground;
+                    gears and the cam plate when those ran; mass and enclosure
+                    checks
 arm_interference    FCL sweep of arm against arm (planting)
 ground_clearance    FCL sweep of every housing against the ground
 plots               PNG pictures of what ran
@@ -34,6 +39,7 @@ the same input.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -57,8 +63,8 @@ EXIT_CHECKS_FAILED = 1
 EFFECT_STAGES = {
     "metrics": ("metrics",),
     "curves": ("kinematics",),
-    "teeth": ("teeth",),
-    "meshing": ("teeth",),      # the meshing check is part of cutting (tip relief needs it)
+    "teeth": ("drivetrain", "teeth"),    # every gear bored for its shaft
+    "meshing": ("drivetrain", "teeth"),  # the meshing check is part of cutting (tip relief)
     "cam": ("cam",),
     "solids": ("cam", "parts"),       # gears among the solids when "teeth" runs too
     "arm_interference": ("cam", "parts", "arm_interference"),
@@ -74,8 +80,9 @@ STAGE_NEEDS = {
     "kinematics": (),
     "metrics": ("kinematics",),
     "cam": ("metrics",),
+    "drivetrain": ("kinematics",),
     "teeth": ("kinematics",),
-    "parts": ("metrics",),
+    "parts": ("metrics", "drivetrain"),
     "arm_interference": ("parts",),
     "ground_clearance": ("parts",),
     "plots": ("kinematics",),
@@ -316,14 +323,36 @@ def _metrics(run):
     return evaluate(params, run.values["kinematics"], steps=run.steps)
 
 
+def _drivetrain(run):
+    from cadgen.machine.drivetrain import drivetrain
+
+    return drivetrain(run.params, run.values["kinematics"])
+
+
 def _teeth(run):
+    """Every gear cut with the process's backlash, then bored for its shaft (when the
+    drivetrain ran): the rim checks ride on the train (``GearTrain.rims``)."""
     from cadgen.gears.trains import planting_train, pricking_train
+    from cadgen.machine.fits import process_fits
 
     def cut(done, total, pair):
         run.progress.step("teeth", pair, steps=total)
 
-    train = pricking_train if run.params.mechanism == "pricking" else planting_train
-    return train(run.params, run.values["kinematics"], progress=cut)
+    params = run.params
+    fits = process_fits(params.manufacturing.process)
+    if params.gears.backlash is None:   # the process's allowance (the file left it out)
+        params = params.model_copy(update={"gears": params.gears.model_copy(
+            update={"backlash": fits.backlash})})
+    make = pricking_train if params.mechanism == "pricking" else planting_train
+    train = make(params, run.values["kinematics"], progress=cut)
+    if run.status("drivetrain") == "ok" and train.stages:
+        from cadgen.machine.hubs import hub_train
+
+        train, rims = hub_train(train, run.values["drivetrain"],
+                                key_slot_allowance=fits.key_slot_allowance,
+                                segments=params.solids.segments_per_circle)
+        train = dataclasses.replace(train, rims=rims)
+    return train
 
 
 def _cam(run):
@@ -345,13 +374,15 @@ def _parts(run, gears: bool = True):
         from cadgen.solids.pricking import pricking_assembly
 
         assembly, housings = pricking_assembly(params, run.values["kinematics"], train,
-                                               run.values["metrics"])
+                                               run.values["metrics"],
+                                               drivetrain=run.values["drivetrain"])
         return solids_outcome(params, assembly, housings)
     from cadgen.solids.planting import planting_assembly
 
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
     assembly, housings, _ = planting_assembly(params, run.values["kinematics"], train, cam,
-                                              run.values["metrics"].events.soil_level)
+                                              run.values["metrics"].events.soil_level,
+                                              drivetrain=run.values["drivetrain"])
     return solids_outcome(params, assembly, {"gearbox1": housings[0], "gearbox2": housings[1]})
 
 
@@ -375,7 +406,8 @@ def _plots(run):
     return build_figures(run)
 
 
-STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "teeth": _teeth, "cam": _cam,
+STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "drivetrain": _drivetrain,
+                   "teeth": _teeth, "cam": _cam,
                    "parts": _parts, "arm_interference": _arm_interference,
                    "ground_clearance": _ground_clearance, "plots": _plots}
 

@@ -4,8 +4,10 @@ Each is a certified least distance (:func:`cadgen.sweep.search.certified_distanc
 from the speed and acceleration bounds of the moving bodies, per radian of carrier
 angle (see that module for the formula ``v + w * reach + u``):
 
-* gearbox 2 and the cam ride on gearbox 2, whose origin C circles at ``Rc`` while
-  the body turns at rate 1: points move at most ``Rc + reach`` (acceleration the same);
+* gearbox 2 (base and cover), its shafts (drawn fixed in the housing: round but
+  for their keyseats) and the cam ride on gearbox 2, whose origin C circles at ``Rc``
+  while the body turns at rate 1: points move at most ``Rc + reach`` (acceleration
+  the same);
 * the planter shell rides on the planter: E's bounds plus its turn (rate at most
   ``max |1 - i|``, angular term read off the planting model's P1 bound) times its
   reach from E;
@@ -14,7 +16,7 @@ angle (see that module for the formula ``v + w * reach + u``):
   is smooth: cycloidal or 3-4-5), times its reach from the hinge, with the
   Coriolis term ``2 w beta'``; its reach from E is at most the hinge's distance
   from E plus that reach, however far it opens;
-* gearbox 1 turns about O at rate 1; the ground is fixed.
+* gearbox 1 (base and cover) turns about O at rate 1; the ground is fixed.
 
 The pair's bound is the sum of the two groups' (arm 2 moves like arm 1). The
 result replaces the kinematic estimate (centre lines, envelope circles) of the
@@ -29,8 +31,15 @@ import numpy as np
 
 __all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
 
-#: Parts of one planting arm (instances carry ``-arm1`` / ``-arm2``).
-ARM_PARTS = ("gearbox2", "cam", "planter-shell", "blade-right", "blade-left")
+#: Parts of one planting arm (instances carry ``-arm1`` / ``-arm2``); those absent from an
+#: assembly are skipped (no cam without a cuttable cam design, ...).
+ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "shaft-E", "cam",
+             "planter-shell", "blade-right", "blade-left")
+#: The parts fixed in gearbox 2's body (the first group of :func:`_arm_bounds`).
+_GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "shaft-E", "cam")
+#: The housings kept clear of the ground: gearbox 1 (one instance) and gearbox 2 (per arm).
+_GROUND_HOUSINGS = {"gearbox1": ("gearbox1-base", "gearbox1-cover"),
+                    "gearbox2": ("gearbox2-base", "gearbox2-cover")}
 #: The certified minimum is within this of the true one (mm), by default (resolution.sweep_atol).
 SWEEP_ATOL = 1e-6
 #: Screening steps per sweep: the second-order screen needs few (benchmarks/sweep.py).
@@ -65,7 +74,7 @@ def _arm_bounds(mechanism, parts, cam):
     rc = mechanism.carrier_radii["C"]
     spin, turn = _planter_turn(mechanism)
     speed, acceleration = [], []
-    for name in ("gearbox2", "cam"):
+    for name in _GEARBOX2_FIXED:
         if name in parts:
             box = rc + part_reach(parts[name], axis=_Z)
             speed.append(box)
@@ -170,18 +179,21 @@ def ground_clearance(params, design, solids, field) -> dict:
     parts = {part.name: part for part in assembly.parts}
     if params.mechanism == "pricking":
         link = design.linkage
-        housings = ["gear-case"]
+        housings = ["gear-case-base", "gear-case-cover"]
         # the case turns about O at rate 1 (a point of it moves at most its reach from O)
         centre = (*np.asarray(link.centre, dtype=float), 0.0)
-        speed = part_reach(parts["gear-case"], body_origin_local=centre, axis=_Z)
+        speed = max(part_reach(parts[name], body_origin_local=centre, axis=_Z)
+                    for name in housings)
         result = certified_distance(FclScene(assembly, housings, ["ground"]), lipschitz=speed,
                                     acceleration=speed, atol=params.resolution.sweep_atol,
                                     steps=SWEEP_STEPS)
         # the case must stay out of the soil (no kinematic estimate for this mechanism)
         return _section(result, "gear case ground clearance (solids, FCL)", 0.0, None)
     rc = design.carrier_radii["C"]
-    housings = ["gearbox1", "gearbox2-arm1", "gearbox2-arm2"]
-    speed = max(part_reach(parts["gearbox1"], axis=_Z), rc + part_reach(parts["gearbox2"], axis=_Z))
+    box1, box2 = _GROUND_HOUSINGS["gearbox1"], _GROUND_HOUSINGS["gearbox2"]
+    housings = list(box1) + [f"{name}-{arm}" for name in box2 for arm in ("arm1", "arm2")]
+    speed = max(max(part_reach(parts[name], axis=_Z) for name in box1),
+                rc + max(part_reach(parts[name], axis=_Z) for name in box2))
     scene = FclScene(assembly, housings, ["ground"])
     result = certified_distance(scene, lipschitz=speed, acceleration=speed,
                                 atol=params.resolution.sweep_atol, steps=SWEEP_STEPS)

@@ -15,7 +15,8 @@ __all__ = ["writers_for"]
 
 
 def writers_for(run) -> list:
-    """The writers of a finished run: curves (CSV), DXF (gears, cam), STL and the assembly."""
+    """The writers of a finished run: curves (CSV), DXF (gears, cam), STL and the assembly,
+    the bill of materials (CSV)."""
     ok = {r.stage for r in run.records if r.status == "ok"}
     effects = set(run.effects)
     writers = []
@@ -30,7 +31,17 @@ def writers_for(run) -> list:
         from cadgen.export.meshes import write_solids
 
         writers.append(lambda staging: write_solids(run.values["parts"], staging))
+    if "parts" in ok and run.report.get("bom"):
+        writers.append(lambda staging: _write_bom(run, staging))
     return writers
+
+
+def _write_bom(run, staging):
+    """bom.csv: every made and bought part with its count (:mod:`cadgen.report.bom`)."""
+    from cadgen.report.bom import bom_csv
+
+    (staging / "bom.csv").write_text(bom_csv(run.report["bom"]), encoding="utf-8")
+    return ["bom.csv"]
 
 
 def _write_gears(run, staging):
@@ -45,10 +56,17 @@ def _write_gears(run, staging):
 def _write_cam(run, staging):
     from cadgen.export.dxf import write_cam_dxf
 
+    from cadgen.solids.planting import cam_bore_radius
+
     params, design = run.params, run.values["cam"]
     points = params.cam.profile_points
+    shafts = run.values.get("drivetrain")
+    if shafts is None:   # a scene with the cam alone: size the shafts here (milliseconds)
+        from cadgen.machine.drivetrain import drivetrain
+
+        shafts = drivetrain(params, run.values["kinematics"])
     write_cam_dxf(staging / "cam.dxf", design.profile.working_profile(points),
-                  design.profile.pitch_curve(points), bore_radius=params.cam.bore_diameter / 2,
+                  design.profile.pitch_curve(points), bore_radius=cam_bore_radius(params, shafts),
                   chord_tolerance=params.gears.chord_tolerance)
     return ["cam.dxf"]
 

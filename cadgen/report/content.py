@@ -10,7 +10,8 @@ import platform
 import numpy as np
 
 __all__ = ["input_hash", "report_dict", "assemble_report", "failures", "check_warnings",
-           "warning_count", "verdict_text", "PREDICTED_FINDINGS", "FAILING_GEAR_PROBLEMS"]
+           "warning_count", "verdict_text", "machine_section", "PREDICTED_FINDINGS",
+           "FAILING_GEAR_PROBLEMS", "FAILING_RIM_PROBLEMS"]
 
 #: Pricking findings that predict what the cutting check measures (the pitch curve bends
 #: tighter than a rack cuts without undercut): a warning, never a failure by themselves; the cut
@@ -20,6 +21,9 @@ PREDICTED_FINDINGS = frozenset({"undercut"})
 #: Gear-check codes that fail a design (read from a report written before problems carried
 #: their ``severity``); ``cadgen.gears.pairs.FAILING_PROBLEMS`` is the source.
 FAILING_GEAR_PROBLEMS = frozenset({"undercut_root_too_thin"})
+#: Rim checks of a gear's bore that fail the design; the others (a thin rim, a gear no shaft
+#: carries) are warnings (:mod:`cadgen.machine.hubs`).
+FAILING_RIM_PROBLEMS = frozenset({"rim_too_thin"})
 
 
 def input_hash(params) -> str:
@@ -142,10 +146,16 @@ def assemble_report(run, set_aside: dict) -> dict:
         from cadgen.cam.design import cam_section
 
         report["cam"] = cam_section(values["cam"])
+    if "drivetrain" in ok:
+        report["machine"] = machine_section(params, values["drivetrain"],
+                                            values["teeth"] if "teeth" in ok else None)
     if "parts" in ok:
+        from cadgen.report.bom import bom_rows
         from cadgen.solids.outcome import solids_report
 
         report["solids"] = solids_report(values["parts"])
+        report["bom"] = bom_rows(values["parts"], report["solids"],
+                                 values["drivetrain"] if "drivetrain" in ok else None, params)
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:
         report["sweep"] = sweeps
@@ -159,6 +169,28 @@ def assemble_report(run, set_aside: dict) -> dict:
     report["versions"] = _versions()
     report["parameters"] = params.model_dump(mode="json")
     return report
+
+
+def machine_section(params, drivetrain, train=None) -> dict:
+    """Shafts, bearings, keys and fits (:func:`cadgen.machine.drivetrain.drivetrain_report`),
+    the process's allowances and materials, and each gear's rim under its bore."""
+    from cadgen.machine.drivetrain import drivetrain_report
+    from cadgen.machine.fits import process_fits
+
+    section = drivetrain_report(drivetrain)
+    section["fits"] = process_fits(params.manufacturing.process).as_dict()
+    rims = []
+    for rim in (train.rims if train is not None else ()):
+        thickness = None if math.isnan(rim.thickness) else float(rim.thickness)
+        rims.append({"gear": rim.gear, "rim_mm": thickness, "limit_mm": float(rim.limit),
+                     "warning_limit_mm": float(rim.warning_limit), "module_mm": float(rim.module),
+                     "passed": bool(rim.passed),
+                     "where_mm": [list(map(float, point)) for point in rim.where],
+                     "problems": [p.as_dict() if hasattr(p, "as_dict") else
+                                  {"path": p.path, "code": p.code, "message": p.message}
+                                  for p in rim.problems]})
+    section["hubs"] = rims
+    return section
 
 
 def _replace_kinematic_estimates(report: dict, sweeps: dict) -> None:
@@ -204,6 +236,13 @@ def failures(report: dict) -> list:
             out.append(f"mesh {mesh['stage']}: {mesh['interference_poses']} interfering poses")
     for problem in report.get("cam", {}).get("problems", []):
         out.append(f"[{problem['code']}] {problem['message']}")
+    machine = report.get("machine", {})
+    for problem in machine.get("problems", []):
+        out.append(f"machine: [{problem['code']}] {problem['message']}")
+    for rim in machine.get("hubs", []):
+        for problem in rim["problems"]:
+            if problem["code"] in FAILING_RIM_PROBLEMS:
+                out.append(f"gear hub {rim['gear']}: [{problem['code']}] {problem['message']}")
     for row in report.get("solids", {}).get("enclosure", []):
         if not row["gears_enclosed"]:
             out.append(f"{row['housing']} does not enclose its gears (margin "
@@ -241,6 +280,11 @@ def check_warnings(report: dict) -> list:
         for problem in gear.get("problems", []):
             if not _gear_problem_fails(problem):
                 out.append({"check": "gear checks", "path": f"gears.{gear['gear']}",
+                            "code": problem["code"], "message": problem["message"]})
+    for rim in report.get("machine", {}).get("hubs", []):
+        for problem in rim["problems"]:
+            if problem["code"] not in FAILING_RIM_PROBLEMS:
+                out.append({"check": "gear hubs", "path": problem.get("path", ""),
                             "code": problem["code"], "message": problem["message"]})
     for finding in report.get("findings", []):
         gear = finding.get("path", "").removeprefix("gears.").replace("_", " ")

@@ -31,6 +31,9 @@ from cadgen.report.html_sections import (_accuracy_section, _cam_section, _gears
                                          _planting_motion_section, _pricking_section,
                                          _solids_section, _stages_section, _sweep_name,
                                          _sweep_section)
+from cadgen.report.html_machine import bom_section_html as _bom_section_html
+from cadgen.report.html_machine import machine_checks
+from cadgen.report.html_machine import machine_section_html as _machine_section_html
 from cadgen.report.html_tables import (_badge, _degrees_ranges, _e, _number, _pass_badge,
                                        _plural, _problem_list, _quantity, _row, _section, _table,
                                        _value_html)
@@ -151,6 +154,8 @@ def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
         detail = "cuttable" if ok else _plural(len(cam.get("problems", [])), "problem")
         checks.append(("cam", ok, detail))
         covered += [f"[{p['code']}]" for p in cam.get("problems", [])]
+    checks += machine_checks(report)
+    covered += ["machine: ", "gear hub "]
     if "solids" in report:
         rows = report["solids"].get("enclosure", [])
         ok = all(r.get("gears_enclosed", True) and r.get("axial_fit", True) for r in rows)
@@ -417,7 +422,8 @@ def render_html(report: dict, figures: dict[str, bytes] | None = None, *,
 
     sections = [*mechanism, *interactive_sections(animation, assembly_glb),
                 _gears_section(report), _cam_section(report),
-                _solids_section(report), _figures_section(figures), _stages_section(report),
+                _machine_section_html(report), _solids_section(report), _bom_section_html(report),
+                _figures_section(figures), _stages_section(report),
                 _accuracy_section(report), _parameters_section(report)]
     sections = [s for s in sections if s]
     titles = re.findall(r'<section id="([^"]+)"><h2>([^<]+)</h2>', "".join(sections))

@@ -281,19 +281,22 @@ def _solids_section(report: dict) -> str:
     solids = report.get("solids")
     if solids is None:
         return ""
-    rows = [[_e(p["part"]), _e(p["kind"]), _e(str(p["instances"])),
+    rows = [[_e(p["part"]), _e(p["kind"]), _e(p.get("material", "—")), _e(str(p["instances"])),
              _e(_number(p["volume_mm3"], 0)), _e(_number(p["mass_kg"])),
              _e(_point(p["centre_of_mass_mm"], 2)), _e(str(p.get("triangles", "—"))),
              _pass_badge(p.get("watertight", True))]
             for p in solids.get("parts", [])]
     assembly = solids.get("assembly", {})
-    body = [f'<p>total mass {_e(_quantity(solids.get("total_mass_kg"), "kg"))} at density '
-            f'{_e(_number(solids.get("density_kg_m3"), trim=True))} kg/m³; assembly '
+    density = (f'density {_number(solids.get("density_kg_m3"), trim=True)} kg/m³'
+               if solids.get("density_kg_m3") is not None else
+               f'each part\'s material ({solids.get("process", "machined")})')
+    body = [f'<p>total mass {_e(_quantity(solids.get("total_mass_kg"), "kg"))} at '
+            f'{_e(density)}; assembly '
             f'<code>{_e(assembly.get("file", "—"))}</code> at carrier angle '
             f'{_e(_number(assembly.get("carrier_angle_deg"), trim=True))} deg</p>',
-            _table(["part", "kind", "instances", "volume (mm³)", "mass each (kg)",
+            _table(["part", "kind", "material", "instances", "volume (mm³)", "mass each (kg)",
                     "centre of mass (mm)", "triangles", "watertight"], rows,
-                   numeric=(2, 3, 4, 6))]
+                   numeric=(3, 4, 5, 7))]
     enclosure, classes = [], []
     for r in solids.get("enclosure", []):
         ok = r.get("gears_enclosed", True) and r.get("axial_fit", True)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 __all__ = ["summary_text", "format_metrics_table", "format_gear_table", "format_cam",
-           "format_solids", "format_clearances", "format_stages", "format_verdict"]
+           "format_solids", "format_machine", "format_clearances", "format_stages", "format_verdict"]
 
 #: Printed for a number the report does not have.
 MISSING = "n/a"
@@ -45,6 +45,8 @@ def summary_text(report: dict) -> str:
         sections.append(format_cam(report["cam"]))
     if "solids" in report:
         sections.append(format_solids(report["solids"]))
+    if "machine" in report:
+        sections.append(format_machine(report["machine"], report.get("bom")))
     sections.append(format_stages(report))
     return "\n\n".join(sections)
 
@@ -179,14 +181,42 @@ def format_cam(cam: dict) -> str:
     return "\n".join(lines)
 
 
+def format_machine(machine: dict, bom=None) -> str:
+    """Plain-text summary of the shafts, bearings, keys, rims and the bill of materials."""
+    shafts = machine.get("shafts", [])
+    lines = [f"machine ({machine.get('process', MISSING)}): "
+             + ", ".join(f"{s['name']} {_number(s['diameter_mm'], 'g')} mm"
+                         for s in shafts if s.get("side", 1) == 1)]
+    bearings = machine.get("bearings", [])
+    if bearings:
+        shortest = min(bearings, key=lambda b: b["l10_h"])
+        lines.append(f"     bearings: {', '.join(sorted({b['designation'] for b in bearings}))}; "
+                     f"shortest L10 {_number(shortest['l10_h'], '.0f')} h ({shortest['shaft']} "
+                     f"{shortest['wall']}), target {_number(shortest['target_h'], 'g')} h")
+    rims = [r for r in machine.get("hubs", []) if r.get("rim_mm") is not None]
+    if rims:
+        thin = min(rims, key=lambda r: r["rim_mm"] / r["module_mm"])
+        lines.append(f"     thinnest rim under a bore: {_number(thin['rim_mm'], '.2f')} mm "
+                     f"({thin['gear']}; fails below {_number(thin['limit_mm'], '.2f')} mm)")
+    for problem in machine.get("problems", []):
+        lines.append(f"     FAIL [{problem['code']}] {problem['message']}")
+    if bom:
+        made = sum(r["quantity"] for r in bom if r["source"] == "make")
+        bought = sum(r["quantity"] for r in bom if r["source"] == "buy")
+        lines.append(f"     bill of materials: {made} made and {bought} bought parts (bom.csv)")
+    return "\n".join(lines)
+
+
 def format_solids(solids: dict) -> str:
     """Plain-text summary of the solids: parts, mass, enclosure."""
     parts = solids["parts"]
     instances = sum(p["instances"] for p in parts)
+    density = (f"{_number(solids['density_kg_m3'], 'g')} kg/m3"
+               if solids.get("density_kg_m3") is not None else
+               f"each part's material ({solids.get('process', 'machined')})")
     lines = [f"solids: {len(parts)} parts ({instances} placed), total mass "
-             f"{_number(solids['total_mass_kg'], '.2f')} kg at "
-             f"{_number(solids['density_kg_m3'], 'g')} kg/m3, assembly at carrier angle "
-             f"{_number(solids['assembly']['carrier_angle_deg'], 'g')} deg"]
+             f"{_number(solids['total_mass_kg'], '.2f')} kg at {density}, assembly at carrier "
+             f"angle {_number(solids['assembly']['carrier_angle_deg'], 'g')} deg"]
     for row in solids["enclosure"]:
         margin = row.get("smallest_margin_mm")
         if margin is None:
@@ -203,7 +233,7 @@ def format_solids(solids: dict) -> str:
         size = " x ".join(_number(v, ".1f") for v in part["print_extents_mm"])
         bed = " x ".join(_number(v, "g") for v in volume) if volume else MISSING
         lines.append(f"     warning: {part['part']} ({part['kind']}) is {size} mm in its printing "
-                     f"pose, larger than the build volume {bed} mm (solids.build_volume)")
+                     f"pose, larger than the build volume {bed} mm (manufacturing.build_volume)")
     return "\n".join(lines)
 
 

@@ -1,10 +1,11 @@
 """Housing and gear-blank dimensions derived from the gears (light: no teeth are generated).
 
-A gearbox housing is a closed shell round the hull of its gears' envelope discs:
-the largest tip radius about each axis plus ``clearance``, then ``wall``. The
-kinematic envelope circles of the clearance checks are those discs grown by the
-wall, i.e. the housing's outside, so the kinematic and the solid checks see the
-same housing. Each dimension left out of the file is derived from the module of
+A gearbox housing is a split shell round the hull of its gears' envelope discs:
+the largest tip radius about each axis plus ``clearance``, then ``wall``, then the
+bolt flange of the base/cover joint. The kinematic envelope circles of the
+clearance checks are those discs grown by the wall and the flange, i.e. the
+housing's outermost edge, so the kinematic and the solid checks see the same
+housing. Each dimension left out of the file is derived from the module of
 the gears the housing holds (:class:`cadgen.params.solids.ShellParameters`).
 """
 
@@ -29,11 +30,26 @@ class ShellSize:
     wall: float
     axial_gap: float
     module: float
+    flange: float = 0.0     # the base/cover joint's flange beyond the wall
 
     @property
     def allowance(self) -> float:
-        """Gear tip to the housing's outside."""
+        """Gear tip to the housing's side wall's outside."""
         return self.clearance + self.wall
+
+    @property
+    def envelope(self) -> float:
+        """Gear tip to the housing's outermost edge (its flange's): the envelope circles'."""
+        return self.clearance + self.wall + self.flange
+
+
+def flange_width(params, wall: float) -> float:
+    """The bolt flange's width (mm) of a housing with side ``wall``: its bolt's clearance hole
+    (:func:`cadgen.solids.machine_parts.housing_bolt`) times :data:`FLANGE_WIDTH_HOLES`."""
+    from cadgen.solids.machine_parts import housing_bolt
+    from cadgen.solids.tolerances import FLANGE_WIDTH_HOLES
+
+    return FLANGE_WIDTH_HOLES * housing_bolt(params, wall)[1]
 
 
 def planting_shells(params, mechanism) -> dict:
@@ -52,8 +68,9 @@ def planting_shells(params, mechanism) -> dict:
         module_c = params.gears.circular_module or module_nc
     size = {}
     for name, module in (("gearbox1", module_c), ("gearbox2", max(module_nc, module_c))):
-        size[name] = ShellSize(housing.clearance_for(module), housing.wall_for(module),
-                               housing.axial_gap, module)
+        wall = housing.wall_for(module)
+        size[name] = ShellSize(housing.clearance_for(module), wall, housing.axial_gap, module,
+                               flange_width(params, wall))
     return size
 
 
@@ -61,8 +78,8 @@ def housing_circles(params, mechanism) -> list:
     """Envelope circles: derived from the gear sizes, with any explicit radius in the file winning."""
     shells = planting_shells(params, mechanism)
     circles = envelope_circles(
-        mechanism, mechanism.module(params.pitch_curve.teeth), shells["gearbox2"].allowance,
-        circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].allowance)
+        mechanism, mechanism.module(params.pitch_curve.teeth), shells["gearbox2"].envelope,
+        circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].envelope)
     explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
     return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
             for c in circles]

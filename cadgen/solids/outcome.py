@@ -1,6 +1,8 @@
 """What a build's solids came to: the assembly, its housings' enclosure checks, mass properties.
 
-The report section lists each part's mass properties at the file's density, per
+The report section lists each part's mass properties at its material's density
+(``[manufacturing] process``, :func:`cadgen.machine.fits.process_fits`; or the
+file's ``solids.density_kg_m3`` for every part), per
 housing whether its gears stay inside the cavity over a revolution, and each part's
 printing pose (:func:`printing_pose`: largest flat face down on z = 0, centred on
 x = y = 0) checked against the printer's build volume; the files are written by
@@ -13,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cadgen.params.solids import DEFAULT_BUILD_VOLUME
+from cadgen.params.machine import DEFAULT_BUILD_VOLUME
 
 __all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "enclosure_checks",
            "printing_pose", "fits_build_volume", "SUPPORT_RTOL", "FACE_AREA_RTOL",
@@ -35,12 +37,13 @@ _NOT_MADE = frozenset({"ground"})
 @dataclass
 class SolidsOutcome:
     assembly: object
-    housings: dict           # housing part name -> Housing (cadgen.solids.shell)
+    housings: dict           # housing name -> Housing (shell) or SplitHousing (split_housing)
     enclosure: list          # one dict per housing
     carrier_angle: float     # rad, the assembly file's pose
-    density: float
+    density: float | None    # kg/m^3 of every made part, or None: each part's material's
     file_type: str
     build_volume: tuple = DEFAULT_BUILD_VOLUME   # mm (x, y, z), the printer's
+    process: str = "machined"                    # [manufacturing] process: parts' materials
     _poses: dict = field(default_factory=dict, repr=False)
 
     def printing_pose(self, part) -> np.ndarray:
@@ -59,7 +62,8 @@ def solids_outcome(params, assembly, housings) -> SolidsOutcome:
     settings = params.solids
     return SolidsOutcome(assembly, housings, enclosure_checks(assembly, housings),
                          settings.assembly_carrier_angle_rad, settings.density_kg_m3,
-                         settings.assembly_format, tuple(settings.build_volume))
+                         settings.assembly_format, tuple(params.manufacturing.build_volume),
+                         params.manufacturing.process)
 
 
 def _turn_onto(normal) -> np.ndarray:
@@ -198,7 +202,10 @@ def enclosure_checks(assembly, housings: dict) -> list:
     for housing_name, housing in housings.items():
         cavity = shapely.Polygon(housing.cavity_outline)
         z_low, z_high = housing.z_cavity_bottom, housing.z_cavity_bottom + housing.cavity_height
-        body = next(p.body for p in assembly.parts if p.name == housing_name)
+        # a closed housing is one part; a split one is "<name>-base" and "<name>-cover" on
+        # the same body
+        body = next(p.body for p in assembly.parts
+                    if p.name in (housing_name, f"{housing_name}-base"))
         worst, worst_gear, axial_ok = np.inf, None, True
         for part in assembly.parts:
             if part.kind != "gear" or part.body != body:
@@ -225,32 +232,40 @@ def enclosure_checks(assembly, housings: dict) -> list:
 
 def solids_report(outcome: SolidsOutcome) -> dict:
     """Mass properties per part, the enclosure checks and the assembly's pose (report.json)."""
+    from cadgen.machine.fits import process_fits
     from cadgen.solids.mass import mass_properties
 
     parts = []
     too_big = []
     total = 0.0
+    materials = process_fits(outcome.process)
     for part in outcome.assembly.parts:
         instances = part.instances or ((part.name, part.body, 0.0),)
         if part.kind in _NOT_MADE:
             continue
-        props = mass_properties(part.mesh, outcome.density)
+        material = materials.material(part.kind)
+        density = outcome.density if outcome.density is not None else material.density
+        props = mass_properties(part.mesh, density)
         total += props["mass_kg"] * len(instances)
         extents = [float(v) for v in np.ptp(outcome.printing_mesh(part).vertices, axis=0)]
-        fits = fits_build_volume(extents, outcome.build_volume)
-        if not fits:
+        printed = material.process == "printed"
+        # only a printed part meets the printer's bed; a machined one is not checked
+        fits = fits_build_volume(extents, outcome.build_volume) if printed else None
+        if printed and not fits:
             too_big.append({"part": part.name, "kind": part.kind, "print_extents_mm": extents})
         parts.append({
             "part": part.name, "kind": part.kind, "instances": len(instances),
             "file": f"solids/{part.name}.stl", "triangles": int(len(part.mesh.faces)),
             "volume_mm3": props["volume_mm3"], "area_mm2": props["area_mm2"],
+            "material": material.name, "process": material.process, "density_kg_m3": density,
             "mass_kg": props["mass_kg"], "centre_of_mass_mm": props["centre_of_mass_mm"].tolist(),
             "inertia_kg_mm2": props["inertia_kg_mm2"].tolist(),
             "watertight": bool(part.mesh.is_watertight),
             "winding_consistent": bool(part.mesh.is_winding_consistent),
             "print_extents_mm": extents, "fits_build_volume": fits,
         })
-    return {"density_kg_m3": outcome.density, "parts": parts, "total_mass_kg": total,
+    return {"density_kg_m3": outcome.density, "process": outcome.process,
+            "parts": parts, "total_mass_kg": total,
             "assembly": {"file": f"solids/assembly.{outcome.file_type}",
                          "carrier_angle_deg": float(np.degrees(outcome.carrier_angle)),
                          "units": "m" if outcome.file_type == "glb" else "mm"},

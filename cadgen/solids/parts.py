@@ -97,14 +97,22 @@ class Assembly:
 def gear_solid(profile, face_width: float, segments: int, path: str, chord_tolerance: float):
     """A gear extruded from its cut outline, with its bore, from z = 0 (its own frame): (solid, outline).
 
-    The outline is the one the gear's DXF holds (thinned to ``chord_tolerance``), so
-    the STL and the cutting file describe the same part.
+    The outline is the one the gear's DXF holds (thinned to ``chord_tolerance``, clear of
+    the hole's reach), so the STL and the cutting file describe the same part. The bore is
+    the profile's ``hole`` (bore with keyway or D-flat, body frame) when set, else a
+    ``segments``-gon of ``bore_radius``.
     """
-    from cadgen.geometry.contour import thinned_outline
+    from cadgen.geometry.contour import thinned_contour
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import circle
 
-    holes = [circle(profile.bore_radius, segments, profile.centre)] if profile.bore_radius > 0 else []
-    outline = thinned_outline(profile, chord_tolerance)
+    hole = getattr(profile, "hole", None)
+    if hole is not None:
+        holes = [np.asarray(hole, dtype=float)]
+    else:
+        holes = [circle(profile.bore_radius, segments, profile.centre)] if profile.bore_radius > 0 else []
+    # the keep-clear disc as the DXF writer's (cadgen.export.dxf._thin_gear): the same outline
+    outline = thinned_contour(profile.outline, chord_tolerance, centre=profile.centre,
+                              bore_radius=getattr(profile, "hole_reach", profile.bore_radius))
     return extrude(outline, face_width, holes=holes, path=path,
                    outline_path=f"gear {profile.name!r} outline"), outline

@@ -17,14 +17,20 @@ the arms. Bodies and their poses at carrier angle ``phi`` (arm 2 is arm 1 at
 
 Axial stack (z, from the machine outwards): gearbox 1 (train 1's gears), gearbox
 2 (layer 1: the non-circular pair; layer 2: the 1:1 circular pair), the cam plate,
-the planter's arm plate, and the duckbill tube beside it. Every gap is
-``housing.axial_gap``. The housings' outlines are the hull of the same envelope
-discs the kinematic clearance checks use (largest tip + clearance + wall), so
-both checks see one housing.
+the planter's arm plate, and the duckbill tube beside it. Every gap between them
+is ``housing.axial_gap``; the housings' end walls, cavity heights, gear layers and
+parting planes are the drivetrain's (:class:`~cadgen.machine.model.HousingStack`,
+end walls thick enough for the bearing seats). The housings' outlines are the
+hull of the same envelope discs the kinematic clearance checks use (largest tip +
+clearance + wall), so both checks see one housing.
+
+Each housing is split at its parting plane into a base and a cover
+(:mod:`cadgen.solids.split_housing`) with the bearing seats bored in its end walls;
+each shaft is a part of its housing's body (:mod:`cadgen.solids.machine_parts`).
 
 Not modelled: train 1's second gear set (ratio -1/2, no sizes in the spec), the
-cam lever, push rod and blade links (their motion is in the cam report), shafts
-and bearings.
+cam lever, push rod and blade links (their motion is in the cam report), the
+bearings themselves, keys and bolts.
 """
 
 from __future__ import annotations
@@ -36,7 +42,7 @@ import numpy as np
 
 from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
 
-__all__ = ["PlantingLayout", "planting_assembly"]
+__all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius"]
 
 
 @dataclass(frozen=True)
@@ -58,40 +64,74 @@ class PlantingLayout:
     arm_thickness: float
     tube_axis: float        # z of the duckbill tube's axis
     tube_radius: float      # outer
+    box1_floor_wall: float = None   # end walls (None: the side wall, a closed shell's)
+    box1_roof_wall: float = None
+    box2_floor_wall: float = None
+    box2_roof_wall: float = None
+    box1_layers: tuple = ()         # absolute z of each gear layer's bottom (): from the gap
+    box2_layers: tuple = ()
+
+    def __post_init__(self):
+        for box in ("box1", "box2"):
+            for end in ("floor", "roof"):
+                if getattr(self, f"{box}_{end}_wall") is None:
+                    object.__setattr__(self, f"{box}_{end}_wall", getattr(self, f"{box}_wall"))
+
+    @property
+    def layer0(self) -> float:
+        """Bottom of gearbox 1's gear layer (train 1)."""
+        return self.box1_layers[0] if self.box1_layers else self.box1_floor + self.gap
 
     @property
     def layer1(self) -> float:
         """Bottom of gearbox 2's first gear layer (the non-circular pair)."""
-        return self.box2_floor + self.gap
+        return self.box2_layers[0] if self.box2_layers else self.box2_floor + self.gap
 
     @property
     def layer2(self) -> float:
         """Bottom of gearbox 2's second gear layer (the 1:1 pair)."""
+        if len(self.box2_layers) > 1:
+            return self.box2_layers[1]
         return self.layer1 + self.face_nc + self.gap
 
     @property
     def z_range(self) -> tuple:
-        return (self.box1_floor - self.box1_wall, self.tube_axis + self.tube_radius)
+        return (self.box1_floor - self.box1_floor_wall, self.tube_axis + self.tube_radius)
 
 
-def layout_of(params, mechanism, shells, cam_design) -> PlantingLayout:
+def layout_of(params, mechanism, shells, cam_design, drivetrain=None) -> PlantingLayout:
+    """The axial stack; with a drivetrain, its housings' end walls, cavities and gear layers.
+
+    Gearbox 1's cavity floor is at z = 0; gearbox 2's floor wall starts ``gap`` above
+    gearbox 1's roof's outer face, the cam ``gap`` above gearbox 2's roof's. Without
+    a drivetrain every end wall is the side wall (closed shells) and the layers are
+    ``gap`` apart.
+    """
     gap = params.housing.axial_gap
     face_nc = params.gears.face_width_for(mechanism.module(params.pitch_curve.teeth))
     face_c = params.gears.face_width_for(shells["gearbox1"].module)
     w1, w2 = shells["gearbox1"].wall, shells["gearbox2"].wall
-    box1_height = face_c + 2 * gap
-    box2_floor = box1_height + w1 + gap + w2
-    box2_height = face_nc + face_c + 3 * gap
-    cam_bottom = box2_floor + box2_height + w2 + gap
+    if drivetrain is not None:
+        stack1, stack2 = drivetrain.stacks["gearbox1"], drivetrain.stacks["gearbox2"]
+        walls = (stack1.floor_wall, stack1.roof_wall, stack2.floor_wall, stack2.roof_wall)
+        box1_height, box2_height = stack1.cavity_height, stack2.cavity_height
+    else:
+        stack1 = stack2 = None
+        walls = (w1, w1, w2, w2)
+        box1_height, box2_height = face_c + 2 * gap, face_nc + face_c + 3 * gap
+    box2_floor = box1_height + walls[1] + gap + walls[2]
+    cam_bottom = box2_floor + box2_height + walls[3] + gap
     cam_thickness = params.cam.thickness if cam_design is not None else 0.0
     arm_bottom = cam_bottom + cam_thickness + gap
     arm_thickness = params.planter.arm_thickness
     tube_radius = _tube_radius(params, cam_design)
     # the tube stands beside the arm plate, overlapping it by one shell wall so they join
     tube_axis = arm_bottom + arm_thickness + tube_radius - params.planter.shell_wall
+    layers1 = tuple(z for z, _ in stack1.layers) if stack1 is not None else ()
+    layers2 = tuple(box2_floor + z for z, _ in stack2.layers) if stack2 is not None else ()
     return PlantingLayout(face_nc, face_c, gap, 0.0, box1_height, w1, box2_floor, box2_height, w2,
                           cam_bottom, cam_thickness, arm_bottom, arm_thickness, tube_axis,
-                          tube_radius)
+                          tube_radius, *walls, layers1, layers2)
 
 
 def _tube_radius(params, cam_design) -> float:
@@ -149,7 +189,7 @@ def _gear_parts(params, mechanism, train, layout, segments):
         body = "gearbox2" if profile.name in in_box2 else "carrier1"
         circular = profile.name not in ("central", "intermediate")
         face = layout.face_c if circular else layout.face_nc
-        z = in_box2.get(profile.name, layout.box1_floor + layout.gap)
+        z = in_box2.get(profile.name, layout.layer0)
         # the gear's placement in its body at the catching pose (both from arm 1 at phi = 0)
         world = planar_transform(angle, centre, z)
         local0 = np.linalg.solve(start(body, 0.0), world)
@@ -171,43 +211,72 @@ def _gear_parts(params, mechanism, train, layout, segments):
     return parts
 
 
-def _housing_parts(params, mechanism, circles, shells, layout, segments):
-    from cadgen.solids.shell import closed_shell
+def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetrain):
+    """Both gearboxes as split housings (base and cover), and every shaft of the drivetrain."""
+    from cadgen.solids.machine_parts import housing_parts, shaft_part, stack_housing
 
     a, r = mechanism.centre_distance, mechanism.r
     radius = {(c.gearbox, c.point): c.radius for c in circles}
     box2 = shells["gearbox2"]
-    discs2 = [(0.0, 0.0, radius["gearbox2", "C"] - box2.allowance),
-              (a, 0.0, radius["gearbox2", "D"] - box2.allowance),
-              (a + 2 * r, 0.0, radius["gearbox2", "E"] - box2.allowance)]
+    discs2 = [(0.0, 0.0, radius["gearbox2", "C"] - box2.envelope),
+              (a, 0.0, radius["gearbox2", "D"] - box2.envelope),
+              (a + 2 * r, 0.0, radius["gearbox2", "E"] - box2.envelope)]
     box1 = shells["gearbox1"]
     line = np.array([math.cos(mechanism.phi0), math.sin(mechanism.phi0)])
     carrier = mechanism.carrier_radii
-    discs1 = [(0.0, 0.0, radius["gearbox1", "O"] - box1.allowance)]
+    discs1 = [(0.0, 0.0, radius["gearbox1", "O"] - box1.envelope)]
     for sign in (1.0, -1.0):   # both arms hang on carrier 1
         for axis in ("A", "B", "C"):
             x, y = sign * carrier[axis] * line
-            discs1.append((x, y, radius["gearbox1", axis] - box1.allowance))
-    housing2 = closed_shell(discs2, height=layout.box2_height, clearance=box2.clearance,
-                            wall=box2.wall, segments=segments, path="housing",
-                            z_cavity_bottom=layout.box2_floor)
-    housing1 = closed_shell(discs1, height=layout.box1_height, clearance=box1.clearance,
-                            wall=box1.wall, segments=segments, path="housing",
-                            z_cavity_bottom=layout.box1_floor)
-    return (Part("gearbox1", "housing", "carrier1", housing1.solid),
-            Part("gearbox2", "housing", "gearbox2", housing2.solid,
-                 instances=(("gearbox2-arm1", "gearbox2", 0.0),
-                            ("gearbox2-arm2", "gearbox2", math.pi)))), (housing1, housing2)
+            discs1.append((x, y, radius["gearbox1", axis] - box1.envelope))
+    housing1 = stack_housing(params, discs1, box1, drivetrain.stacks["gearbox1"],
+                             drivetrain.seats("gearbox1"), z_cavity_bottom=layout.box1_floor,
+                             segments=segments, path="housing.gearbox1")
+    housing2 = stack_housing(params, discs2, box2, drivetrain.stacks["gearbox2"],
+                             drivetrain.seats("gearbox2"), z_cavity_bottom=layout.box2_floor,
+                             segments=segments, path="housing.gearbox2")
+    arms = lambda stem: ((f"{stem}-arm1", "gearbox2", 0.0), (f"{stem}-arm2", "gearbox2", math.pi))
+    parts = (housing_parts("gearbox1", housing1, "carrier1")
+             + housing_parts("gearbox2", housing2, "gearbox2", arms))
+    # the gears' instance rule: gearbox 1's axes on both sides of carrier 1 are side 1's part
+    # twice (the second half a turn on), gearbox 2's once per arm
+    sides = {(s.name, s.side) for s in drivetrain.shafts}
+    for shaft in drivetrain.shafts:
+        if shaft.housing == "gearbox2":
+            parts.append(shaft_part(shaft, housing2, "gearbox2", instances=arms(f"shaft-{shaft.name}"),
+                                    segments=segments))
+        elif shaft.housing == "gearbox1" and shaft.side == 1:
+            stem = f"shaft-{shaft.name}"
+            instances = ((f"{stem}-side1", "carrier1", 0.0),)
+            if (shaft.name, 2) in sides:
+                instances += ((f"{stem}-side2", "carrier1:mirrored", 0.0),)
+            parts.append(shaft_part(shaft, housing1, "carrier1", instances=instances,
+                                    segments=segments))
+    return parts, (housing1, housing2)
 
 
+def cam_bore_radius(params, drivetrain) -> float:
+    """The cam's bore radius (mm): the file's ``cam.bore_diameter`` when given, else E's shaft
+    running hole where it leaves gearbox 2's roof (E's shaft turns inside the cam, which is
+    fixed to gearbox 2); 0 (no bore) without a drivetrain and no value in the file."""
+    if params.cam.bore_diameter is not None:
+        return params.cam.bore_diameter / 2
+    if drivetrain is not None:
+        for shaft in drivetrain.shafts:
+            if shaft.name == "E":
+                for seat in shaft.seats:
+                    if seat.wall == "roof" and seat.through and seat.hole_diameter > 0:
+                        return seat.hole_diameter / 2
+    return 0.0
 
-def _cam_part(params, mechanism, cam_design, layout, segments):
+
+def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
     from cadgen.geometry.contour import thinned_contour
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import circle
 
     points = params.cam.profile_points
-    bore = params.cam.bore_diameter / 2
+    bore = cam_bore_radius(params, drivetrain)
     holes = [circle(bore, segments)] if bore > 0 else []
     # the contour cam.dxf holds, so the STL and the cutting file describe the same cam
     contour = thinned_contour(cam_design.profile.working_profile(points),
@@ -298,27 +367,36 @@ def mechanism_extent(mechanism, circles, steps: int = 360) -> tuple:
     return float(xs.min() - reach), float(xs.max() + reach)
 
 
-def planting_assembly(params, mechanism, train, cam_design, soil_level: float) -> tuple:
+def planting_assembly(params, mechanism, train, cam_design, soil_level: float, *,
+                      drivetrain=None) -> tuple:
     """Every solid of the planting mechanism and the poses of their bodies.
 
-    Returns ``(assembly, housings, layout)``; ``housings`` are the
-    :class:`~cadgen.solids.shell.Housing` records of gearbox 1 and gearbox 2 (for
-    the enclosure checks).
+    ``drivetrain`` is the mechanism's :class:`~cadgen.machine.model.Drivetrain`
+    (shafts, seats, housing stacks); None computes it
+    (:func:`cadgen.machine.drivetrain.drivetrain`). Returns ``(assembly, housings,
+    layout)``; ``housings`` are the :class:`~cadgen.solids.split_housing.SplitHousing`
+    records of gearbox 1 and gearbox 2 (for the enclosure checks: parts
+    ``gearbox1-base``, ``gearbox1-cover``, ``gearbox2-base``, ``gearbox2-cover``).
     """
     from cadgen.solids.housings import housing_circles, planting_shells
     from cadgen.solids.ground import ground_part
 
+    if drivetrain is None:
+        from cadgen.machine.drivetrain import drivetrain as compute_drivetrain
+
+        drivetrain = compute_drivetrain(params, mechanism)
     segments = params.solids.segments_per_circle
     shells = planting_shells(params, mechanism)
     circles = housing_circles(params, mechanism)
-    layout = layout_of(params, mechanism, shells, cam_design)
+    layout = layout_of(params, mechanism, shells, cam_design, drivetrain)
     parts = []
-    housing_parts, housings = _housing_parts(params, mechanism, circles, shells, layout, segments)
+    housing_parts, housings = _housing_parts(params, mechanism, circles, shells, layout, segments,
+                                             drivetrain)
     parts += housing_parts
     if train is not None and train.stages:
         parts += _gear_parts(params, mechanism, train, layout, segments)
     if cam_design is not None and cam_design.cuttable:
-        parts.append(_cam_part(params, mechanism, cam_design, layout, segments))
+        parts.append(_cam_part(params, mechanism, cam_design, layout, segments, drivetrain))
     parts += _planter_parts(params, cam_design, layout, segments)
     x_range = mechanism_extent(mechanism, circles)
     z_range = layout.z_range

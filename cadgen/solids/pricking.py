@@ -5,9 +5,10 @@ angle of a pose is the carrier's turn since the outer dead centre (the gears'
 start position), in the carrier's sense. Bodies:
 
 ``case``
-    The gear case (a closed shell round the sun, the intermediate pair and the
-    planet) turning with the carrier about O; origin O, at the start pose equal to
-    the world.
+    The gear case (a split housing round the sun, the intermediate pair and the
+    planet: ``gear-case-base`` and ``gear-case-cover``, and the shafts
+    ``shaft-sun``, ``shaft-intermediate``, ``shaft-planet``) turning with the
+    carrier about O; origin O, at the start pose equal to the world.
 ``planet``
     Origin B, x along the rocker: the rocker (l1, from B) and the needle (l2,
     perpendicular to it at the rocker's end, its tip at D).
@@ -19,8 +20,10 @@ start position), in the carrier's sense. Bodies:
 Each gear rides on the case and turns by the pair's rotation at the pose; the sun
 is fixed in the world (it turns backwards relative to the case).
 
-Axial stack: the case's cavity (stage 1 layer, then stage 2 layer), the rocker
-outside the case's wall, and the needle beside the rocker.
+Axial stack: the case's cavity (stage 1 layer, then stage 2 layer; end walls,
+cavity height, layers and parting plane from the drivetrain's
+:class:`~cadgen.machine.model.HousingStack`), the rocker ``gap`` above the case's
+roof, and the needle beside the rocker.
 """
 
 from __future__ import annotations
@@ -44,16 +47,26 @@ def _pose_parameters(design, angle):
     return v, phi1 + motion.sense * 2 * math.pi * turns
 
 
-def pricking_assembly(params, design, train, field):
+def pricking_assembly(params, design, train, field, *, drivetrain=None):
     """Every solid of the pricking mechanism and the poses of their bodies.
 
     ``field`` is the list of :class:`~kinematics.pricking_field.InclinationResult`;
-    the ground uses the first. Returns ``(assembly, {"gear-case": Housing})``.
+    the ground uses the first. ``drivetrain`` is the design's
+    :class:`~cadgen.machine.model.Drivetrain`; None computes it
+    (:func:`cadgen.machine.drivetrain.drivetrain`). Returns ``(assembly,
+    {"gear-case": SplitHousing})``.
     """
     from kinematics.pricking_field import needle_geometry
 
     from cadgen.solids.ground import ground_part
-    from cadgen.solids.shell import closed_shell
+    from cadgen.solids.housings import ShellSize
+    from cadgen.solids.machine_parts import housing_parts, shaft_part, stack_housing
+
+    if drivetrain is None:
+        from cadgen.machine.drivetrain import drivetrain as compute_drivetrain
+
+        drivetrain = compute_drivetrain(params, design)
+    stack = drivetrain.stacks["gear-case"]
 
     segments = params.solids.segments_per_circle
     link = design.linkage
@@ -94,7 +107,7 @@ def pricking_assembly(params, design, train, field):
     module = max(design.modules)
     clearance, wall = housing.clearance_for(module), housing.wall_for(module)
     faces = [params.gears.face_width_for(m) for m in design.modules]
-    layers = [gap, 2 * gap + faces[0]]
+    layers = [z for z, _ in stack.layers]
     parts, discs = [], {}
     if train is not None and train.stages:
         from cadgen.gears.trains import _placements
@@ -129,17 +142,20 @@ def pricking_assembly(params, design, train, field):
     if not discs:   # no gears generated: a coarse envelope, each gear within the centre distance
         discs = {0.0: link.a, round(link.a, 6): link.a, round(2 * link.a, 6): link.a}
     circles = [(*(centre + d * line), r) for d, r in sorted(discs.items())]
-    height = faces[0] + faces[1] + 3 * gap
-    case = closed_shell(circles, height=height, clearance=clearance, wall=wall, segments=segments,
-                        path="housing", z_cavity_bottom=0.0)
-    parts.insert(0, Part("gear-case", "housing", "case", case.solid))
-    parts += _rocker_and_needle(params, link, needle, z0=height + wall + gap, segments=segments)
+    height, floor, roof = stack.cavity_height, stack.floor_wall, stack.roof_wall
+    case = stack_housing(params, circles, ShellSize(clearance, wall, gap, module), stack,
+                         drivetrain.seats("gear-case"), z_cavity_bottom=0.0, segments=segments,
+                         path="housing.gear-case")
+    parts[:0] = housing_parts("gear-case", case, "case")
+    parts += [shaft_part(shaft, case, "case", segments=segments)
+              for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
+    parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)
     surface = field[0].surface_level
     theta = math.radians(field[0].inclination_deg)
     reach = 2 * link.a + link.l + max(r for _, _, r in circles)
     x_range = (float(centre[0] - reach), float(centre[0] + reach))
     ground = ground_part(params.ground, surface * math.cos(theta), x_range,
-                         (-wall, height + 2 * wall + gap + 2 * params.linkage.needle_diameter),
+                         (-floor, height + roof + wall + gap + 2 * params.linkage.needle_diameter),
                          ridge_centre=0.0, segments=segments)
     tilt = np.eye(4)
     c, s = math.cos(theta), math.sin(theta)

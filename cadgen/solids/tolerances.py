@@ -38,3 +38,6 @@ from cadgen.params.solids import MIN_WALL  # noqa: E402
 #: Default largest distance (mm) between a polygon and the circle it stands for,
 #: used by :func:`cadgen.solids.outline.segments_for`.
 CHORD_TOLERANCE = 0.01
+#: A split housing's flange width in bolt clearance-hole diameters (the hole on its mid-line,
+#: one diameter of material either side); the kinematic envelope circles include it.
+FLANGE_WIDTH_HOLES = 3.0

@@ -1,0 +1,154 @@
+"""What the machine design of a mechanism comes to: shafts, their bearings and seats, hubs.
+
+These records are the interface between the sizing rules (:mod:`cadgen.machine.drivetrain`,
+numbers only) and the solids that are built from them (:mod:`cadgen.solids`): the
+solids never size anything, the sizing never builds a solid.
+
+Frames and names. Each shaft turns about an axis fixed in one or two housings; an
+axis is named as in the mechanism's spec (planting: ``O``, ``A``, ``B``, ``C`` in
+gearbox 1, ``C2``, ``D``, ``E`` in gearbox 2; pricking: ``sun``, ``intermediate``,
+``planet`` in the gear case). ``xy`` is the axis in the housing's body frame
+(:mod:`cadgen.solids.planting`, :mod:`cadgen.solids.pricking`), mm; an axis of
+gearbox 1 that exists on both sides of carrier 1 is listed once per side (``side``
+1 or 2). Heights ``z`` are measured from the housing's cavity floor (mm, up).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+__all__ = ["Bearing", "KeySize", "BearingSeat", "GearMount", "Shaft", "HousingStack",
+           "Drivetrain"]
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """A deep-groove ball bearing of the catalogue (ISO 15 boundary dimensions), mm and kN."""
+
+    designation: str      # "6004"
+    bore: float           # d
+    outside: float        # D
+    width: float          # B
+    dynamic_load_kn: float    # C, basic dynamic load rating
+    static_load_kn: float     # C0
+
+
+@dataclass(frozen=True)
+class KeySize:
+    """A parallel key and its keyways (DIN 6885-1 / ISO/R 773 form A), mm."""
+
+    width: float          # b
+    height: float         # h
+    shaft_depth: float    # t1, keyseat depth in the shaft
+    hub_depth: float      # t2, keyway depth in the hub
+    length: float         # l, from the standard lengths, no longer than the hub
+
+    @property
+    def designation(self) -> str:
+        return f"parallel key DIN 6885 A {self.width:g} x {self.height:g} x {self.length:g}"
+
+
+@dataclass(frozen=True)
+class BearingSeat:
+    """One bearing in one end wall of a housing, and the seat bored for it.
+
+    ``wall`` is ``"floor"`` or ``"roof"`` (the cavity's lower or upper end wall); the
+    bearing sits in the wall from its inner face outwards, against a shoulder.
+    ``through`` is whether the shaft leaves the housing there (the shoulder then has a
+    hole of ``hole_diameter`` for the shaft with running clearance; otherwise the seat
+    is blind).
+    """
+
+    shaft: str
+    housing: str
+    side: int
+    xy: tuple
+    wall: str
+    bearing: Bearing
+    seat_diameter: float      # bore of the seat: bearing OD + the process's fit
+    through: bool
+    hole_diameter: float      # through: shaft + running clearance; blind: 0
+    load_n: float             # radial load on this bearing (design load x service factor)
+    speed_rpm: float          # mean speed of the inner ring relative to the housing
+    life_h: float             # ISO 281 basic rating life L10h; inf when the load is 0
+    life_min_h: float
+
+    @property
+    def life_passed(self) -> bool:
+        return self.life_h >= self.life_min_h
+
+
+@dataclass(frozen=True)
+class GearMount:
+    """A gear on a shaft: where it sits and what it loads the shaft with."""
+
+    gear: str                 # the gear's name, as in the gear train ("central", "idler 1", ...)
+    z_bottom: float           # from the housing's cavity floor, mm
+    face_width: float
+    torque_nm: float          # transmitted through its hub (0 for an idler)
+    radial_load_n: float      # resultant of its mesh forces on the shaft (N)
+    hub_bore: float           # bore diameter (nominal = the shaft's)
+    key: KeySize | None       # None: a D-flat (small shafts) or a fixed gear
+    flat_depth: float         # D-flat depth from the shaft surface, mm (0: none)
+    bore_allowance: float     # the hub bore's diametral allowance from the process's fit, mm
+
+
+@dataclass(frozen=True)
+class Shaft:
+    """One shaft: its size, what it carries, its bearings, and how its size was chosen."""
+
+    name: str
+    housing: str              # the housing whose floor holds its lower bearing
+    side: int
+    xy: tuple
+    diameter: float           # chosen (preferred size, or given in the file)
+    required_diameter: float  # from torque and bending with the safety factor
+    given: bool               # the file gave the diameter
+    torque_nm: float          # largest torque it transmits (design load x service factor)
+    bending_nmm: float        # largest bending moment between its bearings, N mm
+    speed_rpm: float          # mean speed relative to its housing
+    mounts: tuple             # GearMount, ...
+    seats: tuple              # BearingSeat, ... (lower first)
+    extends_below: float      # beyond the floor's outer face, mm (0: ends in a blind seat)
+    extends_above: float      # beyond the roof's outer face, mm
+    note: str = ""            # what it drives or is driven by beyond the housing
+
+    @property
+    def strength_passed(self) -> bool:
+        return self.diameter >= self.required_diameter - 1e-9
+
+
+@dataclass(frozen=True)
+class HousingStack:
+    """A housing's axial stack: end walls thick enough for its bearing seats, cavity height."""
+
+    housing: str
+    floor_wall: float         # cavity floor's wall: the thicker of the side wall and the deepest
+    roof_wall: float          #   seat in it plus its shoulder
+    cavity_height: float
+    parting_z: float          # the base/cover joint, from the cavity floor
+    layers: tuple             # ((z_bottom, face_width), ...) of the gear layers, from the floor
+
+
+@dataclass(frozen=True)
+class Drivetrain:
+    """Every shaft, bearing seat and housing stack of a mechanism, with the rules used."""
+
+    mechanism: str
+    shafts: tuple
+    stacks: dict              # housing name -> HousingStack
+    process: str
+    rules: dict = field(default_factory=dict)   # the formulas and constants, for the report
+    problems: tuple = ()      # kinematics.errors.Problem of failing checks (life, strength, rim)
+
+    def seats(self, housing: str) -> list:
+        """The bearing seats of one housing, every side."""
+        return [seat for shaft in self.shafts for seat in shaft.seats if seat.housing == housing]
+
+    def shaft_of_gear(self, gear: str) -> tuple:
+        """``(shaft, mount)`` carrying the named gear (side 1 when it exists on both sides)."""
+        for shaft in sorted(self.shafts, key=lambda s: s.side):
+            for mount in shaft.mounts:
+                if mount.gear == gear:
+                    return shaft, mount
+        raise KeyError(f"no shaft carries the gear {gear!r}")

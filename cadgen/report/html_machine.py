@@ -1,0 +1,123 @@
+"""The report page's machine sections: shafts, bearings, keys and rims, fits; the bill of materials.
+
+Each function takes the report (``report.json``'s content) and returns one
+``<section>`` (or ``""`` when the build has no such section), like
+:mod:`cadgen.report.html_sections`.
+"""
+
+from __future__ import annotations
+
+from cadgen.report.html_tables import (_badge, _e, _number, _pass_badge, _problem_list, _section,
+                                       _table)
+
+__all__ = ["machine_section_html", "bom_section_html", "machine_checks"]
+
+
+def machine_checks(report: dict) -> list:
+    """``(name, passed, detail)`` rows of the page's verdict for the machine design."""
+    machine = report.get("machine")
+    if machine is None:
+        return []
+    bearings = machine.get("bearings", [])
+    short = [b for b in bearings if not b.get("passed", True)]
+    shafts = machine.get("shafts", [])
+    problems = machine.get("problems", [])
+    keyed = [p for p in problems if p["code"] == "key_overloaded"]
+    other = [p for p in problems if p["code"] not in ("key_overloaded", "bearing_life_short")]
+    rows = [("bearing life", not short,
+             f"{len(bearings) - len(short)} of {len(bearings)} bearings reach "
+             f"{_number(bearings[0]['target_h'], trim=True) if bearings else '—'} h"),
+            ("keys", not keyed, f"{len(keyed)} overloaded" if keyed else "every key within "
+             "its flank pressure"),
+            ("shafts", not other, f"{len(shafts)} shafts sized" if not other
+             else "; ".join(p["message"] for p in other))]
+    rims = machine.get("hubs", [])
+    if rims:
+        thin = [r for r in rims if not r["passed"]]
+        measured = [r for r in rims if r.get("rim_mm") is not None]
+        thinnest = min(measured, key=lambda r: r["rim_mm"] / r["module_mm"], default=None)
+        detail = (f"thinnest {_number(thinnest['rim_mm'])} mm ({thinnest['gear']}, "
+                  f"{_number(thinnest['rim_mm'] / thinnest['module_mm'])} modules)"
+                  if thinnest else "no gear bored")
+        rows.append(("gear rims under the bores", not thin, detail))
+    return rows
+
+
+def machine_section_html(report: dict) -> str:
+    machine = report.get("machine")
+    if machine is None:
+        return ""
+    fits = machine.get("fits", {})
+    body = [f"<p>process <b>{_e(machine.get('process', '—'))}</b>: bearing seats "
+            f"{_e(fits.get('seat_fit', '—'))}, journals {_e(fits.get('shaft_fit', '—'))}, "
+            f"shaft holes +{_e(_number(fits.get('running_clearance_mm'), trim=True))} mm, "
+            f"keyways +{_e(_number(fits.get('key_slot_allowance_mm'), trim=True))} mm, gear "
+            f"backlash allowance {_e(_number(fits.get('backlash_mm'), trim=True))} mm per gear, "
+            f"bolt holes ISO 273 {_e(fits.get('bolt_hole_series', '—'))}</p>"]
+    rows = []
+    for s in machine.get("shafts", []):
+        hubs = "; ".join(
+            f"{h['gear']}: " + (h["key"]["designation"].removeprefix("parallel key ")
+                                + f" ({_number(h['key'].get('pressure_mpa'), 0)} MPa)"
+                                if h.get("key") else
+                                f"D-flat {_number(h.get('flat_depth_mm'))} mm"
+                                if h.get("flat_depth_mm") else "plain bore")
+            for h in s.get("hubs", []))
+        rows.append([_e(f"{s['name']}" + (f" (side {s['side']})" if s.get("side", 1) != 1
+                                          else "")),
+                     _e(s["housing"]), _e(_number(s["diameter_mm"], trim=True)),
+                     _e(_number(s["required_mm"], 1)), _e(_number(s["torque_nm"], 1)),
+                     _e(_number(s.get("length_mm"), 1)), _e(hubs or "—"),
+                     _pass_badge(s.get("strength_passed", True))])
+    body.append("<h3>Shafts</h3>" + _table(
+        ["shaft", "housing", "diameter (mm)", "required (mm)", "torque (N·m)", "length (mm)",
+         "hubs (key, flank pressure)", "strength"], rows, numeric=(2, 3, 4, 5)))
+    rows, classes = [], []
+    for b in machine.get("bearings", []):
+        rows.append([_e(f"{b['shaft']} {b['wall']}" + (f" (side {b['side']})"
+                                                       if b.get("side", 1) != 1 else "")),
+                     _e(b["designation"]),
+                     _e(f"{_number(b['d_mm'], trim=True)} x {_number(b['D_mm'], trim=True)} x "
+                        f"{_number(b['B_mm'], trim=True)}"),
+                     _e(_number(b["C_kn"], trim=True)), _e(_number(b["seat_diameter_mm"], 4)),
+                     _e(_number(b["load_n"], 0)), _e(_number(b["speed_rpm"], 1)),
+                     _e(_number(b["l10_h"], 0)), _pass_badge(b.get("passed", True))])
+        classes.append("" if b.get("passed", True) else "fail")
+    body.append("<h3>Bearings (ISO 281 basic rating life L10)</h3>" + _table(
+        ["shaft, wall", "bearing", "d x D x B (mm)", "C (kN)", "seat (mm)", "load (N)",
+         "speed (r/min)", "L10 (h)", "life"], rows, numeric=(3, 4, 5, 6, 7), row_classes=classes))
+    rims = machine.get("hubs", [])
+    if rims:
+        rows = [[_e(r["gear"]), _e(_number(r["rim_mm"])), _e(_number(r["limit_mm"])),
+                 _e(_number(r["warning_limit_mm"])),
+                 _badge("fail") if not r["passed"] else
+                 _badge("warn") if r["problems"] else _badge("pass")] for r in rims]
+        body.append("<h3>Rim left under each gear's bore and keyway</h3>" + _table(
+            ["gear", "thinnest rim (mm)", "fails below (mm)", "warns below (mm)", "check"],
+            rows, numeric=(1, 2, 3)))
+    problems = machine.get("problems", [])
+    if problems:
+        body.append(_problem_list(problems))
+    rules = (machine.get("rules") or {}).get("text") or {}
+    if rules:
+        body.append("<details><summary>how the sizes were chosen</summary><ul>"
+                    + "".join(f"<li><b>{_e(k.replace('_', ' '))}</b>: {_e(v)}</li>"
+                              for k, v in rules.items()) + "</ul></details>")
+    return _section("machine", "Shafts, bearings and hubs", "".join(body))
+
+
+def bom_section_html(report: dict) -> str:
+    rows = report.get("bom")
+    if not rows:
+        return ""
+    table = [[_e(str(r["item"])), _e(r["source"]), _e(r["part"]), _e(r["description"]),
+              _e(r["material"]), _e(r["process"]), _e(str(r["quantity"])),
+              _e(_number(r["mass_each_kg"], 3) if r.get("mass_each_kg") is not None else "—"),
+              _e(r["file"] or "—")] for r in rows]
+    made = sum(r["quantity"] for r in rows if r["source"] == "make")
+    bought = sum(r["quantity"] for r in rows if r["source"] == "buy")
+    return _section("bom", "Bill of materials", (
+        f"<p>{made} made parts and {bought} bought parts; the same rows are in "
+        f"<code>bom.csv</code></p>"
+        + _table(["item", "make/buy", "part", "description", "material", "process", "quantity",
+                  "mass each (kg)", "file"], table, numeric=(0, 6, 7))))

@@ -1,0 +1,150 @@
+"""The drivetrain's solids shared by both mechanisms: split housings from stacks, bolts, shafts.
+
+The sizing (:mod:`cadgen.machine`) decides every number: a housing's end walls,
+cavity height and parting plane (:class:`~cadgen.machine.model.HousingStack`), its
+bearing seats, and each shaft's diameter, length beyond the housing and keys
+(:class:`~cadgen.machine.model.Shaft`). This module turns those records into solids
+(:mod:`cadgen.solids.split_housing`) and assembly parts; it sizes nothing but the
+flange bolts, from the housing's side wall when the file does not name them.
+
+Heights. A stack's and a seat's heights are from the housing's cavity floor; the
+parts are built in their body's frame, so every height is offset by the cavity
+floor's ``z`` in that frame.
+
+Shafts are drawn fixed in their housing's frame (not turning with their gears):
+round but for the keyseats, so only the keyseats' angle differs from the turning
+shaft's at other poses, and the collision sweeps need no spin bound for them.
+"""
+
+from __future__ import annotations
+
+from cadgen.solids.parts import Part, planar_transform
+
+__all__ = ["BOLT_BY_WALL", "ISO273_MEDIUM", "housing_bolt", "stack_housing", "housing_parts",
+           "shaft_part", "shaft_ends"]
+
+#: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
+BOLT_BY_WALL = ((4.0, "M3"), (6.0, "M4"), (8.0, "M5"))
+#: ISO 273 medium-series clearance holes (mm), used only when the catalogue is not available.
+ISO273_MEDIUM = {"M3": 3.4, "M4": 4.5, "M5": 5.5, "M6": 6.6, "M8": 9.0, "M10": 11.0}
+
+
+def housing_bolt(params, wall: float) -> tuple:
+    """``(bolt size, clearance hole diameter mm)`` of a housing's flange.
+
+    The size is ``params.housing.bolt_size`` or, when the file leaves it out, the
+    side wall's: M3 below 4 mm, M4 below 6 mm, M5 below 8 mm, else M6 (a bolt's
+    nominal diameter about the wall's thickness, so the flange it needs, 1.5 d per
+    half, stays in proportion with the wall). The hole is ISO 273 in the process's
+    series (:func:`cadgen.machine.catalogue.clearance_hole`) plus the process's
+    extra (printed holes shrink, :func:`cadgen.machine.fits.process_fits`).
+    """
+    size = getattr(params.housing, "bolt_size", None)
+    if size is None:
+        size = next((bolt for below, bolt in BOLT_BY_WALL if wall < below), "M6")
+    try:
+        from cadgen.machine.catalogue import clearance_hole
+        from cadgen.machine.fits import process_fits
+    except ImportError:   # the machine package not installed: the ISO 273 medium table
+        return size, ISO273_MEDIUM[size]
+    fits = process_fits(params.manufacturing.process)
+    return size, clearance_hole(size, fits.bolt_hole_series) + fits.bolt_hole_extra
+
+
+def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: float, segments: int,
+                  path: str = "housing"):
+    """The split housing of one stack round some swept discs.
+
+    Parameters
+    ----------
+    params : Parameters
+        For the bolts (``housing.bolt_size``, ``manufacturing.process``).
+    circles : (k, 3) array_like
+        Swept discs ``(cx, cy, r)`` in the body frame (mm).
+    shell : ShellSize
+        ``clearance`` and side ``wall`` (:mod:`cadgen.solids.housings`).
+    stack : HousingStack
+        End walls, cavity height, parting plane (from the cavity floor).
+    seats : sequence of BearingSeat
+    z_cavity_bottom : float
+        The cavity floor's height in the body frame (mm).
+    segments : int
+    path : str
+
+    Returns
+    -------
+    SplitHousing
+    """
+    from cadgen.solids.split_housing import split_housing
+
+    size, hole = housing_bolt(params, shell.wall)
+    return split_housing(circles, clearance=shell.clearance, wall=shell.wall,
+                         floor_wall=stack.floor_wall, roof_wall=stack.roof_wall,
+                         cavity_height=stack.cavity_height, z_cavity_bottom=z_cavity_bottom,
+                         parting_z=z_cavity_bottom + stack.parting_z,
+                         seats=seats, bolt_size=size,
+                         bolt_hole_diameter=hole, segments=segments, path=path)
+
+
+def housing_parts(name: str, housing, body: str, instances=None) -> list:
+    """``[<name>-base, <name>-cover]`` parts of kind ``housing`` on ``body``.
+
+    ``instances`` is a function of the part name giving its instances (empty: one on
+    ``body``), as the gears' rule.
+    """
+    parts = []
+    for piece, solid in (("base", housing.base), ("cover", housing.cover)):
+        stem = f"{name}-{piece}"
+        parts.append(Part(stem, "housing", body, solid,
+                          instances=instances(stem) if instances else ()))
+    return parts
+
+
+def shaft_ends(shaft, housing) -> tuple:
+    """``(z_bottom, z_top)`` of a shaft in its housing's body frame (mm).
+
+    Each end is the outer end of its bearing seat where the seat is blind (the
+    shaft ends against the shoulder), or the end wall's outer face plus the
+    extension beyond it where the shaft leaves the housing; without a seat in a
+    wall, that wall's outer face.
+    """
+    z0 = housing.z_cavity_bottom
+    z_cavity_top = z0 + housing.cavity_height
+    bottom, top = z0 - housing.floor_wall, z_cavity_top + housing.roof_wall
+    for seat in shaft.seats:
+        if seat.housing != shaft.housing:   # a seat in another housing: not this frame's
+            continue
+        if seat.wall == "floor":
+            bottom = (z0 - housing.floor_wall - shaft.extends_below if seat.through
+                      else z0 - seat.bearing.width)
+        elif seat.wall == "roof":
+            top = (z_cavity_top + housing.roof_wall + shaft.extends_above if seat.through
+                   else z_cavity_top + seat.bearing.width)
+    return bottom, top
+
+
+def shaft_part(shaft, housing, body: str, *, instances=(), segments: int) -> Part:
+    """The shaft of a :class:`~cadgen.machine.model.Shaft` record as a part on ``body``.
+
+    Named ``shaft-<axis>``, kind ``shaft``, built along z at the origin and placed at
+    the shaft's ``xy`` in the body frame. A keyseat (a plain box, see
+    :func:`~cadgen.solids.split_housing.shaft_solid`) under each keyed gear, the
+    key's length centred on the gear's face; a D-flat along the whole length when
+    a gear sits on one.
+    """
+    from cadgen.solids.split_housing import shaft_solid
+
+    z_bottom, z_top = shaft_ends(shaft, housing)
+    keyseats, flat = [], 0.0
+    for mount in shaft.mounts:
+        if mount.key is not None:
+            middle = housing.z_cavity_bottom + mount.z_bottom + mount.face_width / 2
+            length = min(mount.key.length, mount.face_width)
+            keyseats.append((middle - length / 2, middle + length / 2, mount.key.width,
+                             mount.key.shaft_depth, 0.0))
+        flat = max(flat, float(mount.flat_depth or 0.0))
+    solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
+                        segments=segments)
+    offset = tuple(float(v) for v in shaft.xy)
+    return Part(f"shaft-{shaft.name}", "shaft", body, solid,
+                lambda phi, at=planar_transform(0.0, offset): at, tuple(instances))
