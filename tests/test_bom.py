@@ -1,0 +1,139 @@
+"""The bill of materials against the files a build wrote, and the parts against each other.
+
+One real build of the paper's design (teeth, solids, STL, DXF); every count of bom.csv is
+checked against what the written files hold, read back independently: the STL files, the
+assembly's nodes (GLB), the bolt holes cut in each housing's flange (a section of its STL),
+and the shafts' and gears' axes in the assembly.
+"""
+
+import csv
+import io
+import math
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+import trimesh
+
+import cadgen
+from cadgen.params import load_params
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    params = load_params(REPO / "params" / "xin2024-planter.toml")
+    root = tmp_path_factory.mktemp("bom")
+    result = cadgen.build(params, root, effects=["teeth", "solids", "stl", "dxf"])
+    folder = root / params.name
+    rows = list(csv.DictReader(io.StringIO((folder / "bom.csv").read_text(encoding="utf-8"))))
+    scene = trimesh.load(folder / "solids" / "assembly.glb", force="scene")
+    return params, result, folder, rows, scene
+
+
+def _instances(scene, part: str) -> int:
+    """Nodes of the assembly file placing ``part`` (instance names are ``<part>`` or
+    ``<part>-<arm or side>``)."""
+    names = [n for n in scene.graph.nodes_geometry]
+    return sum(1 for n in names if n == part or (n.startswith(part + "-")
+                                                  and n[len(part) + 1:].startswith(("arm", "side"))))
+
+
+def test_every_made_part_is_a_written_file_placed_as_often_as_the_bom_says(built):
+    _, _, folder, rows, scene = built
+    made = [r for r in rows if r["source"] == "make"]
+    stls = sorted(p.name for p in (folder / "solids").glob("*.stl") if p.name != "ground.stl")
+    assert sorted(Path(r["file"]).name for r in made) == stls
+    for row in made:
+        assert int(row["quantity"]) == _instances(scene, row["part"]) > 0, row["part"]
+        assert float(row["mass_each_kg"]) > 0
+
+
+def test_two_bearings_per_shaft_and_their_bores_are_the_shafts(built):
+    _, result, _, rows, scene = built
+    shafts = [r for r in rows if r["source"] == "make" and r["part"].startswith("shaft-")]
+    placed_shafts = sum(_instances(scene, r["part"]) for r in shafts)
+    bearings = [r for r in rows if r["part"] == "bearing"]
+    assert sum(int(r["quantity"]) for r in bearings) == 2 * placed_shafts
+    machine = result.report["machine"]
+    diameters = {(s["name"], s["side"]): s["diameter_mm"] for s in machine["shafts"]}
+    for bearing in machine["bearings"]:
+        assert bearing["d_mm"] == diameters[bearing["shaft"], bearing["side"]]
+
+
+def _bolt_holes(path: Path, z: float, diameter: float) -> int:
+    """Round holes of ``diameter`` in the STL's section at height ``z`` of its printing pose."""
+    mesh = trimesh.load(path)
+    section = mesh.section(plane_origin=[0.0, 0.0, z], plane_normal=[0.0, 0.0, 1.0])
+    planar, _ = section.to_2D()
+    circle = math.pi * diameter**2 / 4
+    # every closed loop of the section whose area is a hole's (a polygon of the hole's circle:
+    # within 1 % of its area); the flange's outline and the cavity are far larger
+    return sum(1 for loop in planar.discrete
+               if abs(shapely.Polygon(loop).area - circle) < 0.01 * circle)
+
+
+def test_bolts_nuts_and_washers_match_the_holes_in_the_flanges(built):
+    params, result, folder, rows, scene = built
+    from cadgen.machine.catalogue import clearance_hole
+    from cadgen.machine.fits import process_fits
+
+    fits = process_fits(params.manufacturing.process)
+    screws, holes = Counter(), Counter()
+    for r in rows:
+        if r["part"] == "socket head cap screw":
+            screws[r["designation"].split()[2]] += int(r["quantity"])   # "ISO 4762 M3 x 16 - 8.8"
+    for housing in ("gearbox1", "gearbox2"):
+        path = folder / "solids" / f"{housing}-base.stl"
+        # the base lies on its floor in its printing pose: its flange is at the top, below the
+        # parting plane; cut it half a flange below its top face
+        mesh = trimesh.load(path)
+        top = float(mesh.bounds[1, 2])
+        thread = "M3" if housing == "gearbox1" else "M4"
+        diameter = clearance_hole(thread, fits.bolt_hole_series) + fits.bolt_hole_extra
+        found = _bolt_holes(path, top - 0.5, diameter)
+        assert found >= 4
+        holes[thread] += found * _instances(scene, f"{housing}-base")
+    assert screws == holes
+    nuts = Counter(r["designation"].split()[2] for r in rows if r["part"] == "hexagon nut"
+                   for _ in range(int(r["quantity"])))
+    washers = sum(int(r["quantity"]) for r in rows if r["part"] == "plain washer")
+    assert nuts == holes and washers == 2 * sum(holes.values())
+
+
+def test_keys_one_per_keyed_gear_placed(built):
+    _, result, _, rows, scene = built
+    keyed = [h["gear"].replace(" ", "-") for s in result.report["machine"]["shafts"]
+             if s["side"] == 1 for h in s["hubs"] if h.get("key")]
+    expected = sum(_instances(scene, gear) for gear in keyed)
+    assert sum(int(r["quantity"]) for r in rows if r["part"] == "key") == expected > 0
+
+
+def test_each_gear_sits_on_its_shaft_axis(built):
+    """The gears are placed from the gear trains' kinematics, the shafts from the drivetrain's
+    axis formulas: at the catching pose each gear's axis is its shaft's, in its body's frame."""
+    params = built[0]
+    from cadgen.design import build_mechanism
+    from cadgen.gears.trains import planting_train
+    from cadgen.machine.drivetrain import drivetrain
+    from cadgen.solids.planting import planting_assembly
+
+    mechanism = build_mechanism(params)
+    shafts = drivetrain(params, mechanism)
+    assembly, _, _ = planting_assembly(params, mechanism, planting_train(params, mechanism), None,
+                                       0.0, drivetrain=shafts)
+    parts = {p.name: p for p in assembly.parts}
+    checked = 0
+    for shaft in shafts.shafts:
+        if shaft.side != 1:
+            continue
+        axis = parts[f"shaft-{shaft.name}"].local(0.0)[:2, 3]
+        for mount in shaft.mounts:
+            gear = parts[mount.gear.replace(" ", "-")]
+            assert gear.body == parts[f"shaft-{shaft.name}"].body
+            np.testing.assert_allclose(gear.local(0.0)[:2, 3], axis, atol=1e-9)
+            checked += 1
+    assert checked == 8
