@@ -98,6 +98,15 @@ def test_report_renders_and_moves_in_chromium(browser, reports, design):
         assert page.evaluate("window.cadgenAnimations[0].frame") == held
         page.locator(".anim-slider").fill("90")
         assert page.locator(".cadgen-animation").get_attribute("data-frame") == "90"
+        # the housings' covers come off and back: gearbox 1's and each arm's gearbox 2's
+        covers = {"xin2024-planter": 3, "kernel-a": 1}[design]
+        assert page.evaluate("window.cadgenViewer.covers") == covers
+        button = page.locator(".viewer-covers")
+        button.click()
+        assert page.evaluate("window.cadgenViewer.coversHidden") is True
+        assert button.inner_text() == "Show covers"
+        button.click()
+        assert page.evaluate("window.cadgenViewer.coversHidden") is False
     finally:
         page.close()
     assert not problems, "\n".join(problems)

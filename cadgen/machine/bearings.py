@@ -53,7 +53,8 @@ def l10_hours(C_kN: float, P_N: float, rpm: float) -> float:
     return (C / P) ** BALL_EXPONENT * 1e6 / (60.0 * rpm)
 
 
-def select_bearing(d: float, load_n: float, rpm: float, life_min_h: float) -> tuple:
+def select_bearing(d: float, load_n: float, rpm: float, life_min_h: float, *,
+                   min_width: float = 0.0) -> tuple:
     """The smallest catalogue bearing of bore ``d`` whose L10h reaches ``life_min_h``.
 
     Parameters
@@ -66,6 +67,9 @@ def select_bearing(d: float, load_n: float, rpm: float, life_min_h: float) -> tu
         Mean speed of the inner ring relative to the housing, r/min.
     life_min_h : float
         The life every bearing must reach, h.
+    min_width : float
+        Only bearings at least this wide (mm) are considered (the drivetrain's rounds never
+        go back to a narrower bearing, so they settle); the widest of the bore when none is.
 
     Returns
     -------
@@ -82,6 +86,8 @@ def select_bearing(d: float, load_n: float, rpm: float, life_min_h: float) -> tu
     candidates = bearings_with_bore(d)
     if not candidates:
         raise ValueError(f"no catalogue bearing has a {d:g} mm bore")
+    wide = [b for b in candidates if b.width >= min_width]
+    candidates = wide or [max(candidates, key=lambda b: (b.width, b.dynamic_load_kn))]
     for bearing in sorted(candidates, key=lambda b: (b.outside, b.width)):
         life = l10_hours(bearing.dynamic_load_kn, load_n, rpm)
         if life >= life_min_h:

@@ -227,8 +227,12 @@ def _size(axis, cavity, walls, widths, given, machine) -> _Sized:
         d = choose_diameter(required) or preferred_diameters()[-1]
     reactions = tuple(abs(v) for v in beam_reactions(z1, z2, loads))
     bore = _journal_bore(d)
-    chosen = tuple(select_bearing(bore, load, axis.loads.speed_rpm, machine.bearing_life_min_h)
-                   for load in reactions)
+    # never a narrower bearing than the last round's: a bearing near its life target could
+    # flip between two widths (a wider wall moves the reactions); growing only, on a finite
+    # catalogue, the rounds settle (and the span is always the chosen bearings')
+    chosen = tuple(select_bearing(bore, load, axis.loads.speed_rpm, machine.bearing_life_min_h,
+                                  min_width=width)
+                   for load, width in zip(reactions, widths))
     return _Sized(d, required, bending, reactions, chosen, overhang)
 
 

@@ -122,7 +122,8 @@ from cadgen.params.cam import CamParameters, CamTimingParameters, DuckbillParame
 from cadgen.params.cutting import CuttingParameters
 from cadgen.params.solids import MIN_WALL, GroundParameters, ShellParameters, SolidsParameters
 from cadgen.params.machine import (DEFAULT_BUILD_VOLUME, PROCESSES, MachineParameters,
-                                   ManufacturingParameters, ShaftDiameters)
+                                   ManufacturingParameters, PrickingMachineParameters,
+                                   PrickingShaftDiameters, ShaftDiameters)
 
 __all__ = [
     "ParameterError",
@@ -155,6 +156,8 @@ __all__ = [
     "MachineParameters",
     "ManufacturingParameters",
     "ShaftDiameters",
+    "PrickingMachineParameters",
+    "PrickingShaftDiameters",
     "PROCESSES",
     "DEFAULT_BUILD_VOLUME",
     "MIN_WALL",

@@ -19,7 +19,7 @@ from pydantic import BeforeValidator, Field
 from cadgen.params._tables import _list_to_tuple, _Table
 
 __all__ = ["DEFAULT_BUILD_VOLUME", "PROCESSES", "MachineParameters", "ManufacturingParameters",
-           "ShaftDiameters"]
+           "ShaftDiameters", "PrickingMachineParameters", "PrickingShaftDiameters"]
 
 #: A common printer bed (x, y, z in mm): 256 mm cube printers are widespread.
 DEFAULT_BUILD_VOLUME = (256.0, 256.0, 256.0)
@@ -28,12 +28,17 @@ DEFAULT_BUILD_VOLUME = (256.0, 256.0, 256.0)
 PROCESSES = ("printed", "machined", "laser", "edm")
 
 
-class ShaftDiameters(_Table):
-    """Shaft diameters given in the file (mm), by axis; an axis left out is sized from its torque.
+class _ShaftDiameters(_Table):
+    """Shaft diameters given in the file (mm), by axis; an axis left out is sized from its torque."""
 
-    Planting: ``O``, ``A``, ``B``, ``C`` (gearbox 1), ``C2`` (the central gear's shaft in
-    gearbox 2), ``D``, ``E``. Pricking: ``sun``, ``intermediate``, ``planet``.
-    """
+    def given(self) -> dict:
+        """``{axis: diameter}`` of the diameters the file gives."""
+        return {k: v for k, v in self.model_dump().items() if v is not None}
+
+
+class ShaftDiameters(_ShaftDiameters):
+    """Planting: ``O``, ``A``, ``B``, ``C`` (gearbox 1), ``C2`` (the central gear's shaft in
+    gearbox 2), ``D``, ``E``."""
 
     O: float | None = Field(None, gt=0)
     A: float | None = Field(None, gt=0)
@@ -42,13 +47,14 @@ class ShaftDiameters(_Table):
     C2: float | None = Field(None, gt=0)
     D: float | None = Field(None, gt=0)
     E: float | None = Field(None, gt=0)
+
+
+class PrickingShaftDiameters(_ShaftDiameters):
+    """Pricking: ``sun``, ``intermediate``, ``planet``."""
+
     sun: float | None = Field(None, gt=0)
     intermediate: float | None = Field(None, gt=0)
     planet: float | None = Field(None, gt=0)
-
-    def given(self) -> dict:
-        """``{axis: diameter}`` of the diameters the file gives."""
-        return {k: v for k, v in self.model_dump().items() if v is not None}
 
 
 class MachineParameters(_Table):
@@ -71,6 +77,13 @@ class MachineParameters(_Table):
     bearing_life_min_h: float = Field(
         5000.0, gt=0, le=1e7, description="basic rating life L10 every bearing must reach, h")
     shafts: ShaftDiameters = ShaftDiameters()
+
+
+class PrickingMachineParameters(MachineParameters):
+    """``[machine]`` of the pricking mechanism: its shafts are the sun's, the intermediate
+    gears' and the planet's."""
+
+    shafts: PrickingShaftDiameters = PrickingShaftDiameters()
 
 
 class ManufacturingParameters(_Table):

@@ -20,7 +20,7 @@ from cadgen.params._problems import _close_keys, _describe, _problems_error, _sh
 from cadgen.params.cutting import CuttingParameters
 from cadgen.params.scene import SceneParameters
 from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
-from cadgen.params.machine import MachineParameters, ManufacturingParameters
+from cadgen.params.machine import ManufacturingParameters, PrickingMachineParameters
 from cadgen.params._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -260,7 +260,7 @@ class PrickingParameters(_Table):
     housing: ShellParameters = ShellParameters()
     ground: GroundParameters = GroundParameters()
     solids: SolidsParameters = SolidsParameters()
-    machine: MachineParameters = MachineParameters()
+    machine: PrickingMachineParameters = PrickingMachineParameters()
     manufacturing: ManufacturingParameters = ManufacturingParameters()
     scene: SceneParameters = SceneParameters()
 

@@ -43,6 +43,25 @@ def machine_checks(report: dict) -> list:
     return rows
 
 
+def _sides(records, key) -> list:
+    """``(record, label)``: a record of side 2 identical to side 1's but for the side is left
+    out and side 1's is labelled "both sides" (gearbox 1's axes A, B, C)."""
+    def payload(record):
+        return {k: v for k, v in record.items() if k not in ("side", "xy_mm")}
+
+    first = {key(r): r for r in records if r.get("side", 1) == 1}
+    twins = {key(r) for r in records if r.get("side", 1) == 2
+             and key(r) in first and payload(r) == payload(first[key(r)])}
+    out = []
+    for r in records:
+        if r.get("side", 1) == 2 and key(r) in twins:
+            continue
+        label = (" (both sides)" if key(r) in twins else
+                 f" (side {r['side']})" if r.get("side", 1) != 1 else "")
+        out.append((r, label))
+    return out
+
+
 def machine_section_html(report: dict) -> str:
     machine = report.get("machine")
     if machine is None:
@@ -55,7 +74,7 @@ def machine_section_html(report: dict) -> str:
             f"backlash allowance {_e(_number(fits.get('backlash_mm'), trim=True))} mm per gear, "
             f"bolt holes ISO 273 {_e(fits.get('bolt_hole_series', '—'))}</p>"]
     rows = []
-    for s in machine.get("shafts", []):
+    for s, side in _sides(machine.get("shafts", []), lambda r: r["name"]):
         hubs = "; ".join(
             f"{h['gear']}: " + (h["key"]["designation"].removeprefix("parallel key ")
                                 + f" ({_number(h['key'].get('pressure_mpa'), 0)} MPa)"
@@ -63,8 +82,7 @@ def machine_section_html(report: dict) -> str:
                                 f"D-flat {_number(h.get('flat_depth_mm'))} mm"
                                 if h.get("flat_depth_mm") else "plain bore")
             for h in s.get("hubs", []))
-        rows.append([_e(f"{s['name']}" + (f" (side {s['side']})" if s.get("side", 1) != 1
-                                          else "")),
+        rows.append([_e(s["name"] + side),
                      _e(s["housing"]), _e(_number(s["diameter_mm"], trim=True)),
                      _e(_number(s["required_mm"], 1)), _e(_number(s["torque_nm"], 1)),
                      _e(_number(s.get("length_mm"), 1)), _e(hubs or "—"),
@@ -73,9 +91,8 @@ def machine_section_html(report: dict) -> str:
         ["shaft", "housing", "diameter (mm)", "required (mm)", "torque (N·m)", "length (mm)",
          "hubs (key, flank pressure)", "strength"], rows, numeric=(2, 3, 4, 5)))
     rows, classes = [], []
-    for b in machine.get("bearings", []):
-        rows.append([_e(f"{b['shaft']} {b['wall']}" + (f" (side {b['side']})"
-                                                       if b.get("side", 1) != 1 else "")),
+    for b, side in _sides(machine.get("bearings", []), lambda r: (r["shaft"], r["wall"])):
+        rows.append([_e(f"{b['shaft']} {b['wall']}{side}"),
                      _e(b["designation"]),
                      _e(f"{_number(b['d_mm'], trim=True)} x {_number(b['D_mm'], trim=True)} x "
                         f"{_number(b['B_mm'], trim=True)}"),

@@ -35,6 +35,7 @@
   scene.add(sun);
   var controls = new T.OrbitControls(camera, canvas);
   var home = null;
+  var covers = [];   // the housings' covers (nodes named <housing>-cover...): hideable
 
   function render() {
     renderer.render(scene, camera);
@@ -69,6 +70,7 @@
       // drawn from both sides since a housing's cavity faces inwards
       if (node.material) node.material.side = T.DoubleSide;
       state.meshes += 1;
+      if (/-cover(-|$)/.test(name)) covers.push(node);
       if (!/^ground/.test(name)) fit.expandByObject(node);   // the soil slab is wide: not framed
     });
     if (fit.isEmpty()) fit.setFromObject(model);
@@ -83,6 +85,8 @@
     controls.addEventListener("change", render);
     goHome();
     resize();
+    state.covers = covers.length;
+    if (covers.length) root.querySelector(".viewer-covers").hidden = false;
     state.state = "ready";
     root.setAttribute("data-state", "ready");
   }, function (error) {
@@ -90,6 +94,13 @@
   });
 
   root.querySelector(".viewer-home").addEventListener("click", goHome);
+  root.querySelector(".viewer-covers").addEventListener("click", function (event) {
+    var hide = covers.length && covers[0].visible;
+    covers.forEach(function (node) { node.visible = !hide; });
+    state.coversHidden = hide;
+    event.target.textContent = hide ? "Show covers" : "Hide covers";
+    render();
+  });
   if (window.ResizeObserver) new ResizeObserver(resize).observe(root);
   window.addEventListener("beforeprint", render);
 })();

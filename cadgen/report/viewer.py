@@ -57,12 +57,14 @@ def viewer_section(glb: bytes | None) -> str:
     return (
         '<section id="view-3d"><h2>3D view of the assembly</h2>'
         f'<p class="note">{html.escape("solids/assembly.glb")} ({size}), embedded: drag to turn, '
-        "scroll to zoom, right-drag to pan. Housings and soil are drawn see-through. Drawn with "
+        "scroll to zoom, right-drag to pan. Housing covers and soil are drawn see-through; "
+        "\u201cHide covers\u201d takes the covers off to show the gears and shafts. Drawn with "
         f"three.js {THREE_VERSION} (MIT), inlined: nothing is fetched.</p>"
         '<div class="viewer" id="cadgen-viewer" data-state="loading">'
         '<canvas aria-label="3D view of the assembly"></canvas>'
         '<p class="viewer-message" hidden></p>'
-        '<button type="button" class="viewer-home">Reset view</button></div>'
+        '<button type="button" class="viewer-home">Reset view</button>'
+        '<button type="button" class="viewer-covers" hidden>Hide covers</button></div>'
         f'<script type="application/octet-stream" id="cadgen-glb">{encoded}</script>'
         f"<script>{vendor}</script><script>{_resource('viewer.js')}</script></section>")
 
