@@ -137,3 +137,14 @@ def test_each_gear_sits_on_its_shaft_axis(built):
             np.testing.assert_allclose(gear.local(0.0)[:2, 3], axis, atol=1e-9)
             checked += 1
     assert checked == 8
+
+
+def test_each_shaft_stl_is_as_long_as_its_stack_says(built):
+    """The sizing gives each shaft's length from its stack (walls, bearing seats, extensions
+    beyond the housing); the solids build the shaft from the housing's geometry: the two agree."""
+    _, result, folder, _, _ = built
+    for shaft in result.report["machine"]["shafts"]:
+        mesh = trimesh.load(folder / "solids" / f"shaft-{shaft['name']}.stl")
+        extents = sorted(mesh.extents)
+        assert extents[2] == pytest.approx(shaft["length_mm"], abs=1e-4)       # float32 STL
+        assert extents[0] == pytest.approx(shaft["diameter_mm"], abs=1e-4)

@@ -43,7 +43,10 @@ def figure_jobs(run) -> dict:
 
         jobs.update(cam_figure_jobs(values["cam"], params.cam.profile_points))
     if "parts" in ok:
+        from cadgen.report.plots.housings import housing_figure_jobs
+
         jobs["assembly.png"] = lambda: _assembly(run)
+        jobs.update(housing_figure_jobs(values["parts"].housings, values.get("drivetrain")))
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:
         from cadgen.report.plots.parts import clearance_figure

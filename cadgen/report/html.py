@@ -320,7 +320,8 @@ def figure_caption(name: str) -> str:
     ``"gears-2-1-1-pair-d-to-e.png"`` -> ``"Gear pair 2: 1:1 pair D to E"``,
     ``"gears-3-train-1-sun-to-idler-1.png"`` -> ``"Gear pair 3: train 1: sun to idler 1"``,
     ``"tip_velocity.png"`` -> ``"Tip speed, relative and absolute"`` (the figures a build draws
-    have captions of their own), ``"mystery_plot.png"`` -> ``"Mystery plot"``.
+    have captions of their own), ``"housing-gearbox1.png"`` -> ``"Housing gearbox1: plan and
+    section through the bearing seats"``, ``"mystery_plot.png"`` -> ``"Mystery plot"``.
     """
     stem = Path(name).stem
     match = re.fullmatch(r"gears-(\d+)-(.+)", stem)
@@ -328,13 +329,23 @@ def figure_caption(name: str) -> str:
         return f"Gear pair {match[1]}: {_gear_pair_words(match[2])}"
     if stem in _CAPTIONS:
         return _CAPTIONS[stem]
+    match = re.fullmatch(r"housing-(.+)", stem)
+    if match:
+        return f"Housing {match[1]}: plan and section through the bearing seats"
     words = re.sub(r"[-_]+", " ", stem).strip()
     return words[:1].upper() + words[1:] if words else name
 
 
 def _figure_order(name: str) -> tuple:
-    """Sort key: the figure's group, then the first of the group's words it holds, then name."""
+    """Sort key: the figure's group, then the first of the group's words it holds, then name.
+
+    A group whose word begins the name wins (``housing-gearbox1`` is a housing's picture,
+    not a gear's); otherwise the first group with a word anywhere in it."""
     stem = Path(name).stem.lower()
+    for index, (_, words) in enumerate(_FIGURE_GROUPS):
+        starts = [k for k, word in enumerate(words) if stem.startswith(word)]
+        if starts:
+            return index, starts[0], _natural_key(name)
     for index, (_, words) in enumerate(_FIGURE_GROUPS):
         matches = [k for k, word in enumerate(words) if word in stem]
         if matches:

@@ -21,7 +21,7 @@ from __future__ import annotations
 from cadgen.solids.parts import Part, planar_transform
 
 __all__ = ["BOLT_BY_WALL", "ISO273_MEDIUM", "housing_bolt", "stack_housing", "housing_parts",
-           "shaft_part", "shaft_ends"]
+           "printed_housing_parts", "shaft_part", "shaft_ends"]
 
 #: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
 BOLT_BY_WALL = ((4.0, "M3"), (6.0, "M4"), (8.0, "M5"))
@@ -98,6 +98,58 @@ def housing_parts(name: str, housing, body: str, instances=None) -> list:
         parts.append(Part(stem, "housing", body, solid,
                           instances=instances(stem) if instances else ()))
     return parts
+
+
+def printed_housing_parts(name: str, housing, body: str, params, instances=None) -> tuple:
+    """A housing's parts, cut into segments when a printed half does not fit the printer.
+
+    With ``[manufacturing] process = "printed"`` each half's printing pose
+    (:func:`cadgen.solids.outcome.printing_pose`) is checked against
+    ``manufacturing.build_volume``; when one does not fit, the housing is cut across
+    its long axis between its bearing seats (:mod:`cadgen.solids.segments`) and the
+    parts are ``<name>-base-1``, ``<name>-base-2``, ..., ``<name>-cover-1``, ... (kind
+    ``housing`` on ``body``, ``instances`` applied to each stem as by
+    :func:`housing_parts`). Otherwise exactly :func:`housing_parts`.
+
+    Returns
+    -------
+    parts : list of Part
+    joints : list of SpliceJoint
+        The bolted splices (empty when the housing is not cut).
+
+    Raises
+    ------
+    DesignError
+        At ``manufacturing.build_volume`` when no split between the seats fits.
+    """
+    import numpy as np
+
+    from cadgen.solids.outcome import fits_build_volume, printing_pose
+
+    parts = housing_parts(name, housing, body, instances)
+    if params.manufacturing.process != "printed":
+        return parts, []
+    volume = tuple(float(v) for v in params.manufacturing.build_volume)
+    # the halves' meshes stay cached on their parts, so the check costs no second conversion
+    if all(fits_build_volume(np.ptp(part.mesh.copy().apply_transform(
+            printing_pose(part.mesh)).vertices, axis=0), volume) for part in parts):
+        return parts, []
+    from cadgen.solids.segments import (SEGMENT_MARGIN, segment_cuts, segment_housing,
+                                        segment_problems)
+    from kinematics.errors import DesignError
+
+    cuts = segment_cuts(housing, volume, margin=SEGMENT_MARGIN)
+    problems = segment_problems(housing, cuts, volume, margin=SEGMENT_MARGIN, name=name)
+    if problems:
+        raise DesignError(problems)
+    split = segment_housing(housing, cuts, segments=housing.segments, name=name)
+    parts = []
+    for half in ("base", "cover"):
+        for piece in split.pieces:
+            stem = f"{name}-{half}-{piece.suffix}"
+            parts.append(Part(stem, "housing", body, getattr(piece, half),
+                              instances=instances(stem) if instances else ()))
+    return parts, list(split.joints)
 
 
 def shaft_ends(shaft, housing) -> tuple:

@@ -213,7 +213,9 @@ def _gear_parts(params, mechanism, train, layout, segments):
 
 def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetrain):
     """Both gearboxes as split housings (base and cover), and every shaft of the drivetrain."""
-    from cadgen.solids.machine_parts import housing_parts, shaft_part, stack_housing
+    from dataclasses import replace
+
+    from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
 
     a, r = mechanism.centre_distance, mechanism.r
     radius = {(c.gearbox, c.point): c.radius for c in circles}
@@ -236,8 +238,13 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
                              drivetrain.seats("gearbox2"), z_cavity_bottom=layout.box2_floor,
                              segments=segments, path="housing.gearbox2")
     arms = lambda stem: ((f"{stem}-arm1", "gearbox2", 0.0), (f"{stem}-arm2", "gearbox2", math.pi))
-    parts = (housing_parts("gearbox1", housing1, "carrier1")
-             + housing_parts("gearbox2", housing2, "gearbox2", arms))
+    # a printed half too big for the printer comes in bolted segments; the splices stay on
+    # the housing record (the bill of materials counts their bolts)
+    parts1, joints1 = printed_housing_parts("gearbox1", housing1, "carrier1", params)
+    parts2, joints2 = printed_housing_parts("gearbox2", housing2, "gearbox2", params, arms)
+    housing1 = replace(housing1, joints=tuple(joints1))
+    housing2 = replace(housing2, joints=tuple(joints2))
+    parts = parts1 + parts2
     # the gears' instance rule: gearbox 1's axes on both sides of carrier 1 are side 1's part
     # twice (the second half a turn on), gearbox 2's once per arm
     sides = {(s.name, s.side) for s in drivetrain.shafts}
@@ -376,7 +383,9 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float, *
     (:func:`cadgen.machine.drivetrain.drivetrain`). Returns ``(assembly, housings,
     layout)``; ``housings`` are the :class:`~cadgen.solids.split_housing.SplitHousing`
     records of gearbox 1 and gearbox 2 (for the enclosure checks: parts
-    ``gearbox1-base``, ``gearbox1-cover``, ``gearbox2-base``, ``gearbox2-cover``).
+    ``gearbox1-base``, ``gearbox1-cover``, ``gearbox2-base``, ``gearbox2-cover``; or, a
+    printed housing too big for the printer, ``gearbox1-base-1``, ... with the splices in
+    the record's ``joints``).
     """
     from cadgen.solids.housings import housing_circles, planting_shells
     from cadgen.solids.ground import ground_part

@@ -60,7 +60,9 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
 
     from cadgen.solids.ground import ground_part
     from cadgen.solids.housings import ShellSize
-    from cadgen.solids.machine_parts import housing_parts, shaft_part, stack_housing
+    from dataclasses import replace
+
+    from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
 
     if drivetrain is None:
         from cadgen.machine.drivetrain import drivetrain as compute_drivetrain
@@ -146,7 +148,10 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
     case = stack_housing(params, circles, ShellSize(clearance, wall, gap, module), stack,
                          drivetrain.seats("gear-case"), z_cavity_bottom=0.0, segments=segments,
                          path="housing.gear-case")
-    parts[:0] = housing_parts("gear-case", case, "case")
+    # cut into bolted segments when printed and too big for the printer (splices kept on it)
+    case_parts, joints = printed_housing_parts("gear-case", case, "case", params)
+    case = replace(case, joints=tuple(joints))
+    parts[:0] = case_parts
     parts += [shaft_part(shaft, case, "case", segments=segments)
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
     parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)

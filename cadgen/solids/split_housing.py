@@ -107,6 +107,9 @@ class SplitHousing:
         The :class:`cadgen.machine.model.BearingSeat` records bored.
     segments : int
         Sides of the circle polygons (seats, holes), so the closed form can rebuild them.
+    joints : tuple
+        The bolted splices between the pieces of a housing cut into segments to fit a
+        printer (:class:`cadgen.solids.segments.SpliceJoint`); empty for a housing made whole.
     """
 
     base: object
@@ -129,6 +132,7 @@ class SplitHousing:
     flange_z: tuple
     seats: tuple
     segments: int
+    joints: tuple = ()
 
     @property
     def solid(self):
