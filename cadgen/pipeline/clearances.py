@@ -26,6 +26,7 @@ metric; the report keeps both.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -40,6 +41,22 @@ _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "sh
 #: The housings kept clear of the ground: gearbox 1 (one instance) and gearbox 2 (per arm).
 _GROUND_HOUSINGS = {"gearbox1": ("gearbox1-base", "gearbox1-cover"),
                     "gearbox2": ("gearbox2-base", "gearbox2-cover")}
+#: A housing half cut into segments to fit a printer: ``<half>-1``, ``<half>-2``, ...
+_SEGMENT = re.compile(r"-\d+$")
+
+
+def _present(names, parts) -> list:
+    """The parts of ``names`` in ``parts``: each name itself, or the segments it was cut into."""
+    out = []
+    for name in names:
+        if name in parts:
+            out.append(name)
+        else:
+            out += [part for part in parts
+                    if part.startswith(f"{name}-") and _SEGMENT.fullmatch(part[len(name):])]
+    return out
+
+
 #: The certified minimum is within this of the true one (mm), by default (resolution.sweep_atol).
 SWEEP_ATOL = 1e-6
 #: Screening steps per sweep: the second-order screen needs few (benchmarks/sweep.py).
@@ -74,11 +91,10 @@ def _arm_bounds(mechanism, parts, cam):
     rc = mechanism.carrier_radii["C"]
     spin, turn = _planter_turn(mechanism)
     speed, acceleration = [], []
-    for name in _GEARBOX2_FIXED:
-        if name in parts:
-            box = rc + part_reach(parts[name], axis=_Z)
-            speed.append(box)
-            acceleration.append(box)
+    for name in _present(_GEARBOX2_FIXED, parts):
+        box = rc + part_reach(parts[name], axis=_Z)
+        speed.append(box)
+        acceleration.append(box)
     if "planter-shell" in parts:
         reach = part_reach(parts["planter-shell"], axis=_Z)
         speed.append(mechanism.speed_bound("E") + spin * reach)
@@ -151,7 +167,7 @@ def arm_interference(params, mechanism, solids, cam) -> dict:
 
     assembly = solids.assembly
     parts = {part.name: part for part in assembly.parts}
-    present = [name for name in ARM_PARTS if name in parts]
+    present = _present(ARM_PARTS, parts)
     scene = FclScene(assembly, [f"{n}-arm1" for n in present], [f"{n}-arm2" for n in present])
     speed, acceleration = _arm_bounds(mechanism, parts, cam)
     # arm 2 is arm 1 half a turn on, so the distance repeats every half turn
@@ -179,7 +195,7 @@ def ground_clearance(params, design, solids, field) -> dict:
     parts = {part.name: part for part in assembly.parts}
     if params.mechanism == "pricking":
         link = design.linkage
-        housings = ["gear-case-base", "gear-case-cover"]
+        housings = _present(["gear-case-base", "gear-case-cover"], parts)
         # the case turns about O at rate 1 (a point of it moves at most its reach from O)
         centre = (*np.asarray(link.centre, dtype=float), 0.0)
         speed = max(part_reach(parts[name], body_origin_local=centre, axis=_Z)
@@ -190,7 +206,8 @@ def ground_clearance(params, design, solids, field) -> dict:
         # the case must stay out of the soil (no kinematic estimate for this mechanism)
         return _section(result, "gear case ground clearance (solids, FCL)", 0.0, None)
     rc = design.carrier_radii["C"]
-    box1, box2 = _GROUND_HOUSINGS["gearbox1"], _GROUND_HOUSINGS["gearbox2"]
+    box1 = _present(_GROUND_HOUSINGS["gearbox1"], parts)
+    box2 = _present(_GROUND_HOUSINGS["gearbox2"], parts)
     housings = list(box1) + [f"{name}-{arm}" for name in box2 for arm in ("arm1", "arm2")]
     speed = max(max(part_reach(parts[name], axis=_Z) for name in box1),
                 rc + max(part_reach(parts[name], axis=_Z) for name in box2))

@@ -18,6 +18,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import re
 from collections import Counter
 
 __all__ = ["BOM_COLUMNS", "bom_rows", "bom_csv", "bolt_set"]
@@ -52,9 +53,23 @@ def _copies(assembly) -> dict:
     """How many times the assembly places each housing (``gearbox2``: once per arm)."""
     out = {}
     for part in assembly.parts:
-        if part.kind == "housing" and part.name.endswith("-base"):
-            out[part.name.removesuffix("-base")] = len(part.instances) or 1
+        # "<name>-base", or "<name>-base-1" for a housing cut into segments (each segment
+        # is placed as often as the whole)
+        if part.kind == "housing" and part.name.endswith(("-base", "-base-1")):
+            stem = part.name.removesuffix("-1").removesuffix("-base")
+            out[stem] = len(part.instances) or 1
     return out
+
+
+def _description(part: dict) -> str:
+    """What a made part is: its kind's words; a housing half says which half and which
+    segment (a printed housing too long for the bed is cut into bolted segments)."""
+    if part["kind"] == "housing":
+        match = re.search(r"-(base|cover)(?:-(\d+))?$", part["part"])
+        if match:
+            half, segment = match.groups()
+            return f"gearbox housing {half}" + (f", segment {segment}" if segment else "")
+    return _DESCRIPTIONS.get(part["kind"], part["kind"])
 
 
 def _made_rows(solids_report: dict, fits) -> list:
@@ -62,7 +77,7 @@ def _made_rows(solids_report: dict, fits) -> list:
     for part in solids_report.get("parts", []):
         material = fits.material(part["kind"])
         rows.append({"source": "make", "part": part["part"],
-                     "description": _DESCRIPTIONS.get(part["kind"], part["kind"]),
+                     "description": _description(part),
                      "designation": "", "material": material.name,
                      "process": material.process, "quantity": int(part["instances"]),
                      "mass_each_kg": part["mass_kg"], "file": part["file"]})
@@ -76,7 +91,8 @@ _DESCRIPTIONS = {"gear": "gear", "housing": "gearbox housing half", "cam": "cam 
 
 def _bought_rows(drivetrain, housings: dict, copies: dict, gears: set) -> list:
     """Bearings of every seat, keys of the gears that were made (``gears``: their part names),
-    and each housing's flange bolts, nuts and washers, times the housing's copies."""
+    and each housing's flange bolts, nuts and washers (and those of the splices joining its
+    segments, when it was cut to fit a printer), times the housing's copies."""
     bearings, keys, fasteners = Counter(), Counter(), Counter()
     describe = {}
     for shaft in drivetrain.shafts:
@@ -95,13 +111,17 @@ def _bought_rows(drivetrain, housings: dict, copies: dict, gears: set) -> list:
         count = len(getattr(housing, "bolt_positions", ()))
         if not count:
             continue
-        n = copies.get(name, 1) * count
-        grip = 2 * float(housing.flange_thickness)
-        bolts = bolt_set(housing.bolt_size, grip)
-        for item, what in ((bolts["screw"], "socket head cap screw"), (bolts["nut"], "hexagon nut"),
-                           (bolts["washer"], "plain washer")):
-            fasteners[item] += n * (2 if what == "plain washer" else 1)
-            describe[item] = (what, item)
+        # the flange's bolts, then each splice's (its own grip: both lugs)
+        sets = [(count, housing.bolt_size, 2 * float(housing.flange_thickness))]
+        sets += [(len(joint.bolts), joint.bolt_size, float(joint.grip))
+                 for joint in getattr(housing, "joints", ())]
+        for per_housing, thread, grip in sets:
+            n = copies.get(name, 1) * per_housing
+            bolts = bolt_set(thread, grip)
+            for item, what in ((bolts["screw"], "socket head cap screw"),
+                               (bolts["nut"], "hexagon nut"), (bolts["washer"], "plain washer")):
+                fasteners[item] += n * (2 if what == "plain washer" else 1)
+                describe[item] = (what, item)
     rows = []
     for counter, kind in ((bearings, "bearing"), (keys, "key"), (fasteners, None)):
         for name in sorted(counter):

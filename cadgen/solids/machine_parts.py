@@ -95,8 +95,10 @@ def housing_parts(name: str, housing, body: str, instances=None) -> list:
     parts = []
     for piece, solid in (("base", housing.base), ("cover", housing.cover)):
         stem = f"{name}-{piece}"
+        # seen along z a half is its flange's outline (the holes through it aside)
         parts.append(Part(stem, "housing", body, solid,
-                          instances=instances(stem) if instances else ()))
+                          instances=instances(stem) if instances else (),
+                          footprint=housing.flange_outline))
     return parts
 
 

@@ -203,9 +203,9 @@ def enclosure_checks(assembly, housings: dict) -> list:
         cavity = shapely.Polygon(housing.cavity_outline)
         z_low, z_high = housing.z_cavity_bottom, housing.z_cavity_bottom + housing.cavity_height
         # a closed housing is one part; a split one is "<name>-base" and "<name>-cover" on
-        # the same body
+        # the same body; a split one cut into segments "<name>-base-1", ... (one body too)
         body = next(p.body for p in assembly.parts
-                    if p.name in (housing_name, f"{housing_name}-base"))
+                    if p.name in (housing_name, f"{housing_name}-base", f"{housing_name}-base-1"))
         worst, worst_gear, axial_ok = np.inf, None, True
         for part in assembly.parts:
             if part.kind != "gear" or part.body != body:

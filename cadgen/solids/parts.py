@@ -50,6 +50,9 @@ class Part:
         use one part); empty for a single instance on ``body`` at phase 0.
     outline : (n, 2) float, optional
         The section a prism part was extruded from (gears), for exact 2D checks.
+    footprint : (n, 2) float, optional
+        The part seen along z (its silhouette in its own frame) when known in closed form: a
+        housing half's flange outline. Pictures draw it instead of merging the triangles.
     """
 
     name: str
@@ -59,6 +62,7 @@ class Part:
     local: Callable = field(default=lambda phi: np.eye(4))
     instances: tuple = ()     # ((instance name, body, phase offset rad), ...); empty: one at body
     outline: object = None    # (n, 2) section of a z-prism part (gears), for exact 2D checks
+    footprint: object = None  # (n, 2) silhouette along z, when known (housing halves)
     _mesh: object = field(default=None, repr=False)
 
     @property

@@ -453,8 +453,8 @@ def _prism(corners, z_low, z_high):
     import manifold3d as m3d
 
     corners = np.asarray(corners, dtype=float)
-    area = np.cross(corners[1] - corners[0], corners[2] - corners[0])
-    if area < 0:   # manifold3d wants counter-clockwise outlines
+    (ax, ay), (bx, by) = corners[1] - corners[0], corners[2] - corners[0]
+    if ax * by - ay * bx < 0:   # manifold3d wants counter-clockwise outlines
         corners = corners[::-1]
     section = m3d.CrossSection([corners.tolist()])
     return m3d.Manifold.extrude(section, z_high - z_low).translate((0.0, 0.0, z_low))

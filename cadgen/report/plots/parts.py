@@ -18,12 +18,13 @@ _COLOURS = {"ground": "#b5895a", "housing": "#8fa3b8", "gear": "#d9a441", "cam":
 
 
 def _silhouette(part, pose):
-    """The part's outline in the world's xy plane: its section for prisms, else its triangles'
-    projections merged (shapely)."""
+    """The part's outline in the world's xy plane: its footprint or its section for prisms when
+    known, else its triangles' projections merged (shapely)."""
     import shapely
 
-    if part.outline is not None:
-        outline = np.asarray(part.outline) @ pose[:2, :2].T + pose[:2, 3]
+    known = part.footprint if getattr(part, "footprint", None) is not None else part.outline
+    if known is not None:
+        outline = np.asarray(known) @ pose[:2, :2].T + pose[:2, 3]
         return shapely.Polygon(outline)
     triangles = part.mesh.triangles @ pose[:3, :3].T + pose[:3, 3]
     flat = triangles[:, :, :2]
