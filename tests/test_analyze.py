@@ -20,7 +20,8 @@ def test_writes_report_and_plots(params, tmp_path):
     plots = sorted(p.name for p in (folder / "plots").iterdir())
     assert [p for p in plots if not p.startswith("gears-")] == [
         "absolute_paths.png", "assembly.png", "attitude.png", "cam-contour.png", "cam-follower.png",
-        "pitch_curves.png", "relative_path.png", "tip_velocity.png"]
+        "housing-gearbox1.png", "housing-gearbox2.png", "pitch_curves.png", "relative_path.png",
+        "tip_velocity.png"]
     assert len([p for p in plots if p.startswith("gears-")]) == 5   # one picture per pair
     dxf = sorted(p.name for p in (folder / "gears").iterdir())
     assert dxf == ["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf", "intermediate.dxf",
@@ -80,7 +81,8 @@ def test_pricking_report_says_where_the_gears_are_concave(tmp_path):
     result = run_analysis(params, output_root=tmp_path)
     folder = tmp_path / "kernel-a"
     assert sorted(p.name for p in (folder / "plots").iterdir()) == [
-        "assembly.png", "field_paths.png", "loop.png", "pitch_curves.png", "ratio.png"]
+        "assembly.png", "field_paths.png", "housing-gear-case.png", "loop.png", "pitch_curves.png",
+        "ratio.png"]
     # kernel-a's gears are too concave for any cutter: said, not drawn
     assert {f["code"] for f in json.loads((folder / "report.json").read_text())
             ["gear_train"]["failures"]} == {"gear_not_cuttable"}

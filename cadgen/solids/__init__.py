@@ -13,6 +13,15 @@ extrude
 shell
     :func:`closed_shell`, a hollow housing round gears' swept discs, and
     :func:`encloses`, the check that a part lies inside its cavity.
+split_housing
+    :func:`~cadgen.solids.split_housing.split_housing`: a housing as a base and a cover
+    parted between gear layers, with bearing seats, shaft holes and a bolted flange;
+    :func:`~cadgen.solids.split_housing.shaft_solid`.
+segments
+    A printed housing too long for the printer's bed, cut between its seats into segments
+    joined by bolted splice lugs.
+machine_parts
+    The drivetrain's records (:mod:`cadgen.machine`) as assembly parts: housings, shafts.
 mass
     :func:`mass_properties`: volume, area, mass, centre of mass, inertia (mm, kg).
 housings, ground, parts, planting, pricking, outcome
