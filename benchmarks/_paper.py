@@ -20,21 +20,24 @@ def sweep_cases():
     from cadgen.sweep.scene import part_reach
 
     params = load_params(PARAMS)
-    run = _Build(params, ["kinematics", "metrics", "cam", "parts"], None)
+    run = _Build(params, ["kinematics", "metrics", "cam", "drivetrain", "parts"], None)
     run.effects, run.case = ["solids"], "field"
     run.run(STAGE_FUNCTIONS)
     mechanism, assembly = run.values["kinematics"], run.values["parts"].assembly
     parts = {part.name: part for part in assembly.parts}
     speed, acceleration = _arm_bounds(mechanism, parts, run.values["cam"])
     rc = mechanism.carrier_radii["C"]
-    ground_speed = max(part_reach(parts["gearbox1"], axis=_Z),
-                       rc + part_reach(parts["gearbox2"], axis=_Z))
+    halves = ("base", "cover")
+    ground_speed = max(max(part_reach(parts[f"gearbox1-{h}"], axis=_Z) for h in halves),
+                       rc + max(part_reach(parts[f"gearbox2-{h}"], axis=_Z) for h in halves))
+    arm = [n for n in ARM_PARTS if n in parts]
+    housings = ([f"gearbox1-{h}" for h in halves]
+                + [f"gearbox2-{h}-arm{k}" for h in halves for k in (1, 2)])
     return [
         ("arm to arm (blades included)",
-         lambda: FclScene(assembly, [f"{n}-arm1" for n in ARM_PARTS],
-                          [f"{n}-arm2" for n in ARM_PARTS]),
+         lambda: FclScene(assembly, [f"{n}-arm1" for n in arm], [f"{n}-arm2" for n in arm]),
          2 * speed, 2 * acceleration, math.pi),
         ("housings to ground",
-         lambda: FclScene(assembly, ["gearbox1", "gearbox2-arm1", "gearbox2-arm2"], ["ground"]),
+         lambda: FclScene(assembly, housings, ["ground"]),
          ground_speed, ground_speed, 2 * math.pi),
     ]

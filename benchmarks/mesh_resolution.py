@@ -59,8 +59,9 @@ def segments_table(params, mechanism):
     box = shells["gearbox2"]
     a, r = mechanism.centre_distance, mechanism.r
     radius = {c.point: c.radius for c in housing_circles(params, mechanism) if c.gearbox == "gearbox2"}
-    discs = [(0.0, 0.0, radius["C"] - box.allowance), (a, 0.0, radius["D"] - box.allowance),
-             (a + 2 * r, 0.0, radius["E"] - box.allowance)]
+    # the envelope circles reach the flange's edge: the gears' discs are inside by that much
+    discs = [(0.0, 0.0, radius["C"] - box.envelope), (a, 0.0, radius["D"] - box.envelope),
+             (a + 2 * r, 0.0, radius["E"] - box.envelope)]
     height = 33.5
 
     def exact_hull(grow):

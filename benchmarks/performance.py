@@ -130,7 +130,7 @@ def main(argv=None):
              f"| metrics only (`--effects metrics`) | 0.5 s | {metrics['best']:.2f} | "
              f"{metrics['median']:.2f} | {len(metrics['runs'])} |", "",
              "Stages of the full build (last run, seconds; the rest of the wall time is "
-             "interpreter start, imports and writing 44 files):", "",
+             "interpreter start, imports and writing the files):", "",
              "| stage | seconds |", "|---|---:|"]
     lines += [f"| {stage} | {seconds:.3f} |" for stage, seconds in full["stages"].items()]
     lines += ["", "## Certified sweep against a plain scan", "",

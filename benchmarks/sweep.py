@@ -34,8 +34,9 @@ from .accuracy import timed
 
 REPO = Path(__file__).resolve().parents[1]
 PARAMS = REPO / "params" / "xin2024-planter.toml"
-ARM_PARTS = ("gearbox2", "cam", "planter-shell")
-HOUSINGS = ("gearbox1", "gearbox2-arm1", "gearbox2-arm2")
+ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "cam", "planter-shell")
+HOUSINGS = ("gearbox1-base", "gearbox1-cover", "gearbox2-base-arm1", "gearbox2-base-arm2",
+            "gearbox2-cover-arm1", "gearbox2-cover-arm2")
 Z = (0.0, 0.0, 1.0)
 STEPS = 360
 ATOL = 1e-6
@@ -71,7 +72,8 @@ def arm_bounds(mechanism, parts):
     closure, rc = mechanism.closure, mechanism.carrier_radii["C"]
     spin = max(abs(1.0 - closure.ratio_min), abs(1.0 - closure.ratio_max))
     turn = (mechanism.acceleration_bound("P1") - mechanism.acceleration_bound("E")) / mechanism.L1
-    box = rc + max(part_reach(parts[n], axis=Z) for n in ("gearbox2", "cam"))
+    box = rc + max(part_reach(parts[n], axis=Z)
+                   for n in ("gearbox2-base", "gearbox2-cover", "cam"))
     reach = part_reach(parts["planter-shell"], axis=Z)
     return (max(box, mechanism.speed_bound("E") + spin * reach),
             max(box, mechanism.acceleration_bound("E") + turn * reach))
@@ -85,8 +87,9 @@ def cases(mechanism, assembly):
     parts = {part.name: part for part in assembly.parts}
     speed, acceleration = arm_bounds(mechanism, parts)
     rc = mechanism.carrier_radii["C"]
-    ground_speed = max(part_reach(parts["gearbox1"], axis=Z),
-                       rc + part_reach(parts["gearbox2"], axis=Z))
+    ground_speed = max(max(part_reach(parts[f"gearbox1-{h}"], axis=Z) for h in ("base", "cover")),
+                       rc + max(part_reach(parts[f"gearbox2-{h}"], axis=Z)
+                                for h in ("base", "cover")))
     out = []
     start = time.perf_counter()
     arms = FclScene(assembly, [f"{n}-arm1" for n in ARM_PARTS], [f"{n}-arm2" for n in ARM_PARTS])
