@@ -148,3 +148,51 @@ def test_each_shaft_stl_is_as_long_as_its_stack_says(built):
         extents = sorted(mesh.extents)
         assert extents[2] == pytest.approx(shaft["length_mm"], abs=1e-4)       # float32 STL
         assert extents[0] == pytest.approx(shaft["diameter_mm"], abs=1e-4)
+
+
+def _direction(points) -> float:
+    """Direction (rad) of the mean of some (n, 2) points about the origin."""
+    mean = np.asarray(points, dtype=float).mean(axis=0)
+    return math.atan2(mean[1], mean[0])
+
+
+def test_each_keyseat_lies_under_its_gears_keyway_at_every_pose(built):
+    """The keyseats cut into a shaft fix the gears' phasing on it: measured on the meshes, each
+    keyseat (the shaft's vertices at its bottom, t1 deep) points where its gear's keyway (the
+    bore's vertices at the keyway's bottom) points, in their body, at three carrier angles."""
+    params = built[0]
+    from cadgen.design import build_mechanism
+    from cadgen.gears.trains import planting_train
+    from cadgen.machine.drivetrain import drivetrain
+    from cadgen.machine.hubs import hub_train
+    from cadgen.solids.planting import planting_assembly
+
+    mechanism = build_mechanism(params)
+    shafts = drivetrain(params, mechanism)
+    train, _ = hub_train(planting_train(params, mechanism), shafts)
+    assembly, _, _ = planting_assembly(params, mechanism, train, None, 0.0, drivetrain=shafts)
+    parts = {p.name: p for p in assembly.parts}
+    holes = {profile.name: profile.hole for profile, *_ in train.gears}
+    checked = 0
+    for shaft in shafts.shafts:
+        if shaft.side != 1:
+            continue
+        part = parts[f"shaft-{shaft.name}"]
+        vertices = part.mesh.vertices
+        radius = np.linalg.norm(vertices[:, :2], axis=1)
+        for mount in shaft.mounts:
+            key = mount.key
+            gear = parts[mount.gear.replace(" ", "-")]
+            z0 = gear.local(0.0)[2, 3]
+            inside = (vertices[:, 2] > z0 - 1e-6) & (vertices[:, 2] < z0 + mount.face_width + 1e-6)
+            seat = vertices[inside & (radius < shaft.diameter / 2 - key.shaft_depth / 2), :2]
+            hole = holes[mount.gear]
+            keyway = hole[np.linalg.norm(hole, axis=1) > mount.hub_bore / 2 + key.hub_depth / 2]
+            assert len(seat) and len(keyway)
+            for phi in (0.0, 1.3, 4.0):
+                turn_shaft = math.atan2(part.local(phi)[1, 0], part.local(phi)[0, 0])
+                turn_gear = math.atan2(gear.local(phi)[1, 0], gear.local(phi)[0, 0])
+                gap = (turn_shaft + _direction(seat)) - (turn_gear + _direction(keyway))
+                assert abs(math.remainder(gap, 2 * math.pi)) < 1e-9, (shaft.name, mount.gear, phi)
+            checked += 1
+    assert checked == 8

@@ -363,8 +363,10 @@ def hub_train(train, drivetrain, *, key_slot_allowance: float = 0.0, segments: i
         angle = best_keyway_angle(profile.outline - centre,
                                   lambda turn: hub_hole(mount.hub_bore, angle=turn, **options))
         hole = hub_hole(mount.hub_bore, angle=angle, **options) + centre
+        # the keyway's direction rides on the profile: the shaft's keyseat goes under it
         holed = dataclasses.replace(profile, hole=hole,
-                                    bore_radius=(mount.hub_bore + mount.bore_allowance) / 2)
+                                    bore_radius=(mount.hub_bore + mount.bore_allowance) / 2,
+                                    notes={**profile.notes, "keyway_angle_rad": float(angle)})
         bored[profile.name] = holed
         checks.append(rim_check(holed, hole, path=f"machine.shafts.{shaft.name}"))
     stages = []

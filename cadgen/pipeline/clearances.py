@@ -4,10 +4,13 @@ Each is a certified least distance (:func:`cadgen.sweep.search.certified_distanc
 from the speed and acceleration bounds of the moving bodies, per radian of carrier
 angle (see that module for the formula ``v + w * reach + u``):
 
-* gearbox 2 (base and cover), its shafts (drawn fixed in the housing: round but
-  for their keyseats) and the cam ride on gearbox 2, whose origin C circles at ``Rc``
-  while the body turns at rate 1: points move at most ``Rc + reach`` (acceleration
-  the same);
+* gearbox 2 (base and cover) and the cam ride on gearbox 2, whose origin C circles at
+  ``Rc`` while the body turns at rate 1: points move at most ``Rc + reach``
+  (acceleration the same);
+* a shaft of gearbox 2 also turns on its axis with its gears (rate at most ``S``, the
+  largest of 1 and ``max |dF/dphi|``; angular acceleration at most ``A``, the largest
+  ``|d2F/dphi2|`` over 20,000 samples plus 25 %): ``Rc + reach + S r`` and
+  ``Rc + reach + (2 S + S^2 + A) r`` with ``r`` its radius;
 * the planter shell rides on the planter: E's bounds plus its turn (rate at most
   ``max |1 - i|``, angular term read off the planting model's P1 bound) times its
   reach from E;
@@ -37,7 +40,9 @@ __all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
 ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "shaft-E", "cam",
              "planter-shell", "blade-right", "blade-left")
 #: The parts fixed in gearbox 2's body (the first group of :func:`_arm_bounds`).
-_GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "shaft-E", "cam")
+_GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
+#: Gearbox 2's shafts, turning on their axes with their gears.
+_GEARBOX2_SHAFTS = ("shaft-C2", "shaft-D", "shaft-E")
 #: The housings kept clear of the ground: gearbox 1 (one instance) and gearbox 2 (per arm).
 _GROUND_HOUSINGS = {"gearbox1": ("gearbox1-base", "gearbox1-cover"),
                     "gearbox2": ("gearbox2-base", "gearbox2-cover")}
@@ -84,6 +89,18 @@ def _blade_rates(cam, mechanism, samples: int = 20_000):
             SAMPLED_MARGIN * float(np.max(np.abs(np.gradient(rate, step)))))
 
 
+def _shaft_rates(mechanism, samples: int = 20_000):
+    """Largest spin rate and its rate of gearbox 2's shafts against the carrier angle: the
+    central gear's is 1, the intermediate's and planet's ``|dF/dphi|`` (the largest over
+    the samples plus 25 %); ``|d2F/dphi2|`` sampled likewise (the central gear's is 0)."""
+    phi = np.linspace(0.0, 2 * np.pi, samples + 1)
+    F = np.asarray(mechanism.intermediate_rotation(phi), dtype=float)
+    step = phi[1] - phi[0]
+    rate = np.gradient(F, step)
+    return (max(1.0, SAMPLED_MARGIN * float(np.max(np.abs(rate)))),
+            SAMPLED_MARGIN * float(np.max(np.abs(np.gradient(rate, step)))))
+
+
 def _arm_bounds(mechanism, parts, cam):
     """(speed, acceleration) bounds of any point of one arm's parts that are present."""
     from cadgen.sweep.scene import part_reach
@@ -95,6 +112,15 @@ def _arm_bounds(mechanism, parts, cam):
         box = rc + part_reach(parts[name], axis=_Z)
         speed.append(box)
         acceleration.append(box)
+    shafts = [name for name in _GEARBOX2_SHAFTS if name in parts]
+    if shafts:
+        rate, rate_rate = _shaft_rates(mechanism)
+        for name in shafts:
+            shaft = parts[name]
+            radius = float(np.max(np.linalg.norm(shaft.mesh.vertices[:, :2], axis=1)))
+            reach = float(np.hypot(*shaft.local(0.0)[:2, 3])) + radius
+            speed.append(rc + reach + rate * radius)
+            acceleration.append(rc + reach + (2 * rate + rate**2 + rate_rate) * radius)
     if "planter-shell" in parts:
         reach = part_reach(parts["planter-shell"], axis=_Z)
         speed.append(mechanism.speed_bound("E") + spin * reach)

@@ -11,12 +11,13 @@ Heights. A stack's and a seat's heights are from the housing's cavity floor; the
 parts are built in their body's frame, so every height is offset by the cavity
 floor's ``z`` in that frame.
 
-Shafts are drawn fixed in their housing's frame (not turning with their gears):
-round but for the keyseats, so only the keyseats' angle differs from the turning
-shaft's at other poses, and the collision sweeps need no spin bound for them.
+A shaft turns with its gears (given their placements) and has a keyseat under each
+keyed gear's keyway: the keyseats' relative angles are the gears' phasing on the shaft.
 """
 
 from __future__ import annotations
+
+import math
 
 from cadgen.solids.parts import Part, planar_transform
 
@@ -177,7 +178,12 @@ def shaft_ends(shaft, housing) -> tuple:
     return bottom, top
 
 
-def shaft_part(shaft, housing, body: str, *, instances=(), segments: int) -> Part:
+def _turn_of(transform) -> float:
+    """The rotation about z (rad) of a 4x4 rigid transform."""
+    return math.atan2(transform[1, 0], transform[0, 0])
+
+
+def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=None) -> Part:
     """The shaft of a :class:`~cadgen.machine.model.Shaft` record as a part on ``body``.
 
     Named ``shaft-<axis>``, kind ``shaft``, built along z at the origin and placed at
@@ -185,20 +191,43 @@ def shaft_part(shaft, housing, body: str, *, instances=(), segments: int) -> Par
     :func:`~cadgen.solids.split_housing.shaft_solid`) under each keyed gear, the
     key's length centred on the gear's face; a D-flat along the whole length when
     a gear sits on one.
+
+    ``gears`` (``{gear name: (local placement callable, keyway angle rad)}``, the gear
+    parts' placements in the body and each bore's keyway direction in the gear's frame)
+    makes the shaft turn with its gears and puts each keyseat under its gear's keyway:
+    the keyseats' relative angles are the gears' phasing on the shaft, which the workshop
+    cuts into it. Without it the shaft is fixed in the body, keyseats towards +x.
     """
     from cadgen.solids.split_housing import shaft_solid
 
     z_bottom, z_top = shaft_ends(shaft, housing)
-    keyseats, flat = [], 0.0
+    gears = {name: value for name, value in (gears or {}).items()
+             if name in {mount.gear for mount in shaft.mounts}}
+    first = next((gears[m.gear][0] for m in shaft.mounts if m.gear in gears), None)
+    frame0 = _turn_of(first(0.0)) if first is not None else 0.0
+
+    def direction(mount) -> float:
+        # the keyway's direction in the body at phi = 0, in the shaft's frame
+        if mount.gear not in gears:
+            return 0.0
+        local, keyway = gears[mount.gear]
+        return _turn_of(local(0.0)) + keyway - frame0
+
+    keyseats, flat, flat_angle = [], 0.0, 0.0
     for mount in shaft.mounts:
         if mount.key is not None:
             middle = housing.z_cavity_bottom + mount.z_bottom + mount.face_width / 2
             length = min(mount.key.length, mount.face_width)
             keyseats.append((middle - length / 2, middle + length / 2, mount.key.width,
-                             mount.key.shaft_depth, 0.0))
-        flat = max(flat, float(mount.flat_depth or 0.0))
+                             mount.key.shaft_depth, direction(mount)))
+        if float(mount.flat_depth or 0.0) > flat:
+            flat, flat_angle = float(mount.flat_depth), direction(mount)
     solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
-                        segments=segments)
+                        flat_angle=flat_angle, segments=segments)
     offset = tuple(float(v) for v in shaft.xy)
-    return Part(f"shaft-{shaft.name}", "shaft", body, solid,
-                lambda phi, at=planar_transform(0.0, offset): at, tuple(instances))
+    if first is None:
+        local = (lambda phi, at=planar_transform(0.0, offset): at)
+    else:   # the gears on one shaft turn together: the shaft turns with the first of them
+        def local(phi, first=first, offset=offset):
+            return planar_transform(_turn_of(first(phi)), offset)
+    return Part(f"shaft-{shaft.name}", "shaft", body, solid, local, tuple(instances))

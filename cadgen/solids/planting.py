@@ -164,7 +164,8 @@ def body_poses(mechanism, layout):
 
 # ------------------------------------------------------------------ parts
 def _gear_parts(params, mechanism, train, layout, segments):
-    """Every gear of both trains, in its body, turning with the carrier angle."""
+    """Every gear of both trains, in its body, turning with the carrier angle: ``(parts,
+    frames)``, ``frames`` each gear's ``(placement, keyway angle)`` for its shaft's keyseat."""
     from cadgen.gears.trains import _placements
 
     n = mechanism.n
@@ -184,7 +185,7 @@ def _gear_parts(params, mechanism, train, layout, segments):
     in_box2 = {"central": layout.layer1, "intermediate": layout.layer1,
                "gear D": layout.layer2, "planet gear E": layout.layer2}
     start = body_poses(mechanism, layout)
-    parts = []
+    parts, frames = [], {}
     for profile, angle, centre in _placements(train):
         body = "gearbox2" if profile.name in in_box2 else "carrier1"
         circular = profile.name not in ("central", "intermediate")
@@ -208,10 +209,12 @@ def _gear_parts(params, mechanism, train, layout, segments):
                      ((profile.file_stem + "-side1", "carrier1", 0.0),
                       (profile.file_stem + "-side2", "carrier1:mirrored", 0.0)))
         parts.append(Part(profile.file_stem, "gear", body, solid, local, instances, outline))
-    return parts
+        frames[profile.name] = (local, float(profile.notes.get("keyway_angle_rad", 0.0)))
+    return parts, frames
 
 
-def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetrain):
+def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetrain,
+                   gears=None):
     """Both gearboxes as split housings (base and cover), and every shaft of the drivetrain."""
     from dataclasses import replace
 
@@ -251,14 +254,14 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
             parts.append(shaft_part(shaft, housing2, "gearbox2", instances=arms(f"shaft-{shaft.name}"),
-                                    segments=segments))
+                                    segments=segments, gears=gears))
         elif shaft.housing == "gearbox1" and shaft.side == 1:
             stem = f"shaft-{shaft.name}"
             instances = ((f"{stem}-side1", "carrier1", 0.0),)
             if (shaft.name, 2) in sides:
                 instances += ((f"{stem}-side2", "carrier1:mirrored", 0.0),)
             parts.append(shaft_part(shaft, housing1, "carrier1", instances=instances,
-                                    segments=segments))
+                                    segments=segments, gears=gears))
     return parts, (housing1, housing2)
 
 
@@ -398,12 +401,12 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float, *
     shells = planting_shells(params, mechanism)
     circles = housing_circles(params, mechanism)
     layout = layout_of(params, mechanism, shells, cam_design, drivetrain)
-    parts = []
+    gear_parts, frames = (_gear_parts(params, mechanism, train, layout, segments)
+                          if train is not None and train.stages else ([], {}))
+    # the shafts turn with their gears, keyseats under the gears' keyways
     housing_parts, housings = _housing_parts(params, mechanism, circles, shells, layout, segments,
-                                             drivetrain)
-    parts += housing_parts
-    if train is not None and train.stages:
-        parts += _gear_parts(params, mechanism, train, layout, segments)
+                                             drivetrain, frames)
+    parts = housing_parts + gear_parts
     if cam_design is not None and cam_design.cuttable:
         parts.append(_cam_part(params, mechanism, cam_design, layout, segments, drivetrain))
     parts += _planter_parts(params, cam_design, layout, segments)

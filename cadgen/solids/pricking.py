@@ -110,7 +110,7 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
     clearance, wall = housing.clearance_for(module), housing.wall_for(module)
     faces = [params.gears.face_width_for(m) for m in design.modules]
     layers = [z for z, _ in stack.layers]
-    parts, discs = [], {}
+    parts, discs, frames = [], {}, {}
     if train is not None and train.stages:
         from cadgen.gears.trains import _placements
 
@@ -139,6 +139,7 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
             solid, outline = gear_solid(profile, faces[index], segments, path="gears.face_width",
                                         chord_tolerance=params.gears.chord_tolerance)
             parts.append(Part(profile.file_stem, "gear", "case", solid, local, outline=outline))
+            frames[profile.name] = (local, float(profile.notes.get("keyway_angle_rad", 0.0)))
     # the case: round the discs the gears sweep at O, A and B (2a from O)
     line = np.array([math.cos(start), math.sin(start)])
     if not discs:   # no gears generated: a coarse envelope, each gear within the centre distance
@@ -152,7 +153,8 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
     case_parts, joints = printed_housing_parts("gear-case", case, "case", params)
     case = replace(case, joints=tuple(joints))
     parts[:0] = case_parts
-    parts += [shaft_part(shaft, case, "case", segments=segments)
+    # the shafts turn with their gears, keyseats under the gears' keyways
+    parts += [shaft_part(shaft, case, "case", segments=segments, gears=frames)
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
     parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)
     surface = field[0].surface_level

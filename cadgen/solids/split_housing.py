@@ -475,7 +475,7 @@ def split_encloses(housing, part, *, volume_atol: float = ENCLOSURE_VOLUME_ATOL)
 
 
 def shaft_solid(diameter: float, z_bottom: float, z_top: float, *, keyseats=(),
-                flat_depth: float = 0.0, segments: int):
+                flat_depth: float = 0.0, flat_angle: float = 0.0, segments: int):
     """A round shaft along z at the origin, with keyseats and an optional D-flat.
 
     Parameters
@@ -491,8 +491,9 @@ def shaft_solid(diameter: float, z_bottom: float, z_top: float, *, keyseats=(),
         round ends; here it is a plain box (its length is the key's, so the box is
         the keyseat's straight part extended to the full key length).
     flat_depth : float
-        Depth (mm) of a D-flat along the whole length, on the +x side, < the radius;
-        0 for none.
+        Depth (mm) of a D-flat along the whole length, < the radius; 0 for none.
+    flat_angle : float
+        Direction (rad from +x) the flat faces (the hub's flat sits there).
     segments : int
         Sides of the section, >= 3.
 
@@ -520,7 +521,9 @@ def shaft_solid(diameter: float, z_bottom: float, z_top: float, *, keyseats=(),
                                             f"not {flat_depth!r}")
     section = circle(radius, segments)
     if flat_depth > 0:
-        cut = shapely.box(radius - flat_depth, -2 * radius, 2 * radius, 2 * radius)
+        cut = shapely.affinity.rotate(
+            shapely.box(radius - flat_depth, -2 * radius, 2 * radius, 2 * radius),
+            float(flat_angle), origin=(0.0, 0.0), use_radians=True)
         flat = shapely.Polygon(section).difference(cut)
         section = np.asarray(shapely.geometry.polygon.orient(flat).exterior.coords)[:-1]
     solid = extrude(section, z_top - z_bottom, z0=z_bottom, path="shaft.length",
