@@ -89,6 +89,12 @@ def _png(figure) -> bytes:
     import matplotlib.pyplot as plt
 
     buffer = io.BytesIO()
+    engine = figure.get_layout_engine()
+    if engine is not None:
+        # savefig draws a figure with a layout engine twice (a pre-draw that solves the layout,
+        # then the draw); solving it here and dropping the engine draws it once, same pixels
+        engine.execute(figure)
+        figure.set_layout_engine(None)
     # no software/date metadata, so the same design gives the same bytes; light compression
     # (level 3 of 9) saves most of the encoding time for files a little larger
     figure.savefig(buffer, format="png", metadata={"Software": None},
