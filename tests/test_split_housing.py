@@ -207,3 +207,25 @@ def test_shaft_solid_volume(flat_depth, keyseats):
                                        angle, origin=(0.0, 0.0), use_radians=True)
         expected -= section.intersection(slot).area * (z_to - z_from)
     assert np.isclose(shaft.volume(), expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize("phi", [0.0, 1.3, 4.0])
+def test_the_paper_designs_gears_turn_inside_base_and_cover(planting_solids, phi):
+    """The real gears of both gearboxes, placed in their housing's body at three carrier
+    angles (their local placement turns them on their axes), lie in the cavity: nothing of
+    them outside it, nothing in the base's or the cover's material (manifold booleans)."""
+    from cadgen.solids.split_housing import split_encloses
+
+    params, *_, assembly, housings, _ = planting_solids
+    by_body = {"carrier1": housings[0], "gearbox2": housings[1]}
+    checked = 0
+    for part in assembly.parts:
+        if part.kind != "gear":
+            continue
+        housing = by_body[part.body]
+        placed = part.solid.transform(part.local(phi)[:3, :])
+        enclosed, outside = split_encloses(housing, placed)
+        assert enclosed, (part.name, outside)
+        assert (placed ^ housing.base).is_empty() and (placed ^ housing.cover).is_empty()
+        checked += 1
+    assert checked == 8
