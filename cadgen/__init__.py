@@ -52,6 +52,10 @@ _EXPORTS = {
     # a build's progress as it runs: the events, and the printer the command line uses
     "ProgressEvent": "cadgen.pipeline.progress",
     "ProgressPrinter": "cadgen.report.progress",
+    # the cache of cut gears (cadgen build --no-cache, cadgen cache clear|info)
+    "cache_directory": "cadgen.pipeline.gear_cache",
+    "clear_cache": "cadgen.pipeline.gear_cache",
+    "cache_info": "cadgen.pipeline.gear_cache",
     # many designs
     "run_batch": "cadgen.batch",
     "expand_grid": "cadgen.batch",

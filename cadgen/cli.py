@@ -1,5 +1,5 @@
-"""Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``), ``cadgen batch``
-and ``cadgen new`` (a starting parameter file).
+"""Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``), ``cadgen batch``,
+``cadgen new`` (a starting parameter file) and ``cadgen cache clear|info`` (the gear cache).
 
 Exit codes (every command):
 
@@ -119,12 +119,14 @@ def _cmd_build(args: argparse.Namespace) -> int:
     import cadgen
     from cadgen import OutputDirError, ProgressPrinter
 
+    # the cache is the build's default; passed only when turned off, the one case to ask for
+    options = {"cache": False} if getattr(args, "no_cache", False) else {}
     # stages as they start and end, on stderr: stdout keeps the summary
     try:
         with ProgressPrinter(sys.stderr) as printer:
             result = cadgen.build(params, output_root=Path(args.output_dir),
                                   effects=args.effects, case=args.case, steps=args.steps,
-                                  preset=args.preset, progress=printer)
+                                  preset=args.preset, progress=printer, **options)
     except OutputDirError:
         raise                       # main() says it, the same way for every command
     except MechanismError as exc:   # stages report their own failures; this is anything else
@@ -152,7 +154,37 @@ def _add_build_arguments(command: argparse.ArgumentParser) -> None:
                               "overriding [scene] preset (default: standard)")
     command.add_argument("--steps", metavar="N", type=_steps, default=None,
                          help="steps per revolution, overriding [resolution] steps_per_revolution")
+    command.add_argument("--no-cache", action="store_true",
+                         help="cut every gear, neither reading nor filling the gear cache "
+                              "(see 'cadgen cache info')")
     command.set_defaults(handler=_cmd_build)
+
+
+def _size(count: int) -> str:
+    """Bytes in a unit a person reads: ``812 B``, ``4.2 MB``."""
+    if count < 1000:
+        return f"{count} B"
+    for unit in ("kB", "MB", "GB"):
+        count /= 1000
+        if count < 1000 or unit == "GB":
+            break
+    return f"{count:.1f} {unit}"
+
+
+def _cmd_cache(args: argparse.Namespace) -> int:
+    from cadgen import cache_info, clear_cache
+
+    if args.action == "clear":
+        removed = clear_cache()
+        plural = "y" if removed["entries"] == 1 else "ies"
+        print(f"removed {removed['entries']} gear cache entr{plural} "
+              f"({_size(removed['bytes'])}) from {removed['directory']}")
+        return EXIT_OK
+    info = cache_info()
+    print(f"directory: {info['directory']}{'' if info['exists'] else ' (not created yet)'}")
+    print(f"entries:   {info['entries']}")
+    print(f"size:      {_size(info['bytes'])}")
+    return EXIT_OK
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -203,6 +235,14 @@ def build_parser() -> argparse.ArgumentParser:
     new.add_argument("--output", "-o", metavar="FILE", default=None,
                      help="the file to write (default: NAME.toml)")
     new.set_defaults(handler=_cmd_new)
+
+    cache = commands.add_parser(
+        "cache", help="show or clear the cache of cut gears",
+        description="The cache of cut gears that makes a second build of the same gears fast "
+        "(in the user's cache directory, or $CADGEN_CACHE_DIR). 'info' prints its directory, "
+        "entries and size; 'clear' removes every entry and prints what it removed.")
+    cache.add_argument("action", choices=("info", "clear"), help="what to do")
+    cache.set_defaults(handler=_cmd_cache)
     return parser
 
 

@@ -47,3 +47,14 @@ def planting_solids():
     assembly, housings, layout = planting_assembly(params, mechanism, train, cam,
                                                    evaluation.events.soil_level)
     return params, mechanism, evaluation, cam, train, assembly, housings, layout
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _session_gear_cache(tmp_path_factory):
+    """The session's builds use a gear cache of their own, never the user's: ``CADGEN_CACHE_DIR``
+    (read by ``cadgen.cache_directory``, inherited by worker processes) names a temporary
+    directory. Builds in the suite then run as a designer's do, cold first and warm after;
+    the tests that need every gear cut pass ``cache=False``."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("CADGEN_CACHE_DIR", str(tmp_path_factory.mktemp("gear-cache")))
+        yield

@@ -31,9 +31,9 @@ def params():
     return load_params(REFERENCE)
 
 
-def run_with_events(params, effects, output_root=None):
+def run_with_events(params, effects, output_root=None, cache=True):
     events = []
-    result = build(params, output_root, effects=effects, progress=events.append)
+    result = build(params, output_root, effects=effects, progress=events.append, cache=cache)
     return result, events
 
 
@@ -64,7 +64,8 @@ def test_stages_start_and_finish_in_plan_order_in_one_process(params, monkeypatc
 
 @pytest.mark.skipif(not cadgen.pipeline.figures._can_fork(), reason="needs fork and 2 cores")
 def test_the_sweeps_report_from_their_second_process_while_the_teeth_are_cut(params):
-    result, events = run_with_events(params, SIDE_BY_SIDE)
+    # the gears cut (no cache), so the teeth take their time beside the sweeps
+    result, events = run_with_events(params, SIDE_BY_SIDE, cache=False)
     stages, _ = plan(SIDE_BY_SIDE, "planting", "field")
     here = [(e.stage, e.state) for e in events if not e.beside and e.state != "step"]
     assert here == [(s, state) for s in stages if s not in SWEEP_STAGES

@@ -11,6 +11,7 @@ by design name; :func:`write_summary` writes ``batch-summary.csv`` and
 
     cadgen batch FILE ... [--grid GRID] [--output-dir DIR] [--workers N]
                  [--scheduler ADDRESS] [--timeout SECONDS | --in-process] [--strict]
+                 [--no-cache]
 
 Faults
 ------
@@ -126,8 +127,10 @@ def add_batch_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
     """Add the ``cadgen batch`` arguments to ``parser`` (a subcommand's parser) and return it.
 
     ``FILE ...``, ``--grid GRID`` (repeatable), ``--output-dir DIR``, ``--workers N``,
-    ``--scheduler ADDRESS``, ``--timeout SECONDS`` or ``--in-process``, ``--strict``; also
-    sets the default ``handler=main_batch``.
+    ``--scheduler ADDRESS``, ``--timeout SECONDS`` or ``--in-process``, ``--strict``,
+    ``--no-cache`` (each design's build then neither reads nor fills the gear cache; on
+    Dask, each worker machine has its own cache directory); also sets the default
+    ``handler=main_batch``.
     """
     parser.add_argument("files", nargs="*", metavar="FILE", help="TOML parameter file")
     parser.add_argument("--grid", action="append", default=[], metavar="GRID",
@@ -154,6 +157,8 @@ def add_batch_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
                              "with local processes, every unfinished design) with it")
     parser.add_argument("--strict", action="store_true",
                         help="also exit 1 if a design misses one of its targets")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="cut every gear, neither reading nor filling the gear cache")
     parser.set_defaults(handler=main_batch)
     return parser
 
@@ -190,7 +195,10 @@ def main_batch(args: argparse.Namespace) -> int:
                               scheduler=args.scheduler, on_result=progress.update,
                               on_start=progress.started,
                               timeout=getattr(args, "timeout", None),
-                              isolate=not getattr(args, "in_process", False))
+                              isolate=not getattr(args, "in_process", False),
+                              # only when asked: a custom build need not take ``cache``
+                              build_kwargs={"cache": False} if getattr(args, "no_cache", False)
+                              else None)
     except (ImportError, OSError) as exc:  # no dask, or the scheduler cannot be reached
         print(f"cadgen batch: {exc}", file=sys.stderr)
         return EXIT_PROBLEMS

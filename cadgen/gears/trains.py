@@ -65,19 +65,46 @@ def _system(cutting, module) -> ToothSystem:
 CIRCULAR_PITCH_POSES = 32
 
 
-def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=False):
+def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=False, cache=None):
+    """One pair cut, checked and meshed (tip relief if needed); looked up in ``cache`` first
+    (a :class:`~cadgen.gears.cache.GearCache` or None) and stored there once computed."""
     bore = cutting.bore_diameter / 2
-    options = dict(system=system, bore_radius=bore, flank_points=cutting.flank_points,
-                   force_shaper=cutting.cutter == "shaper")
+    force_shaper = cutting.cutter == "shaper"
+    counts = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
+    # a circular pair's mesh repeats every tooth pitch: one pitch, finely, checks every pose
+    span = pair.period / counts[0] if circular else None
+    poses = cutting.meshing_poses or (CIRCULAR_PITCH_POSES if circular
+                                      else max(96, 8 * max(counts)))
+    key = None
+    if cache is not None:
+        from cadgen.gears.cache import stage_key
+
+        key = stage_key(name, pair, teeth, system, flank_points=cutting.flank_points,
+                        bore_radius=bore, force_shaper=force_shaper, poses=poses, span=span,
+                        circular=circular, drive=drive)
+        stored = cache.get(key)
+        if stored is not None:
+            generated, report, relief = stored
+            # the pair's contact functions are closures, never stored: the caller's, re-attached
+            return GearStage(name, dataclasses.replace(generated, pair=pair), report, placement,
+                             relief)
+    stage = _cut_stage(name, pair, teeth, system, bore, force_shaper, cutting.flank_points,
+                       placement, drive, poses, span)
+    if cache is not None:   # a stage that raised (DesignError) never gets here: not cached
+        cache.put(key, (dataclasses.replace(stage.generated, pair=None), stage.meshing,
+                        stage.relief))
+    return stage
+
+
+def _cut_stage(name, pair, teeth, system, bore, force_shaper, flank_points, placement, drive,
+               poses, span):
+    options = dict(system=system, bore_radius=bore, flank_points=flank_points,
+                   force_shaper=force_shaper)
     if drive is not None:
         generated = generate_pair(pair, teeth, drive_phase=drive[0], drive_gear=drive[1],
                                   **options)
     else:
         generated = generate_pair(pair, teeth, **options)
-    # a circular pair's mesh repeats every tooth pitch: one pitch, finely, checks every pose
-    span = pair.period / generated.teeth[0] if circular else None
-    poses = cutting.meshing_poses or (CIRCULAR_PITCH_POSES if circular
-                                      else max(96, 8 * max(generated.teeth)))
     report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses,
                            span=span)
     relief = None
@@ -136,10 +163,11 @@ def _report_to(progress, total):
     return cut
 
 
-def planting_train(params, mechanism, progress=None) -> GearTrain:
+def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     """The planting mechanism's gears at the catching position (phi = 0).
 
     ``progress(done, total, pair name)``, optional, is called as each of the five pairs is cut.
+    ``cache``, a :class:`~cadgen.gears.cache.GearCache` or None, answers pairs cut before.
     """
     cut = _report_to(progress, 5)
     cutting = params.gears
@@ -150,7 +178,7 @@ def planting_train(params, mechanism, progress=None) -> GearTrain:
     C = np.asarray(mechanism.positions(np.array([0.0]), points=("C",))["C"][0])
     module_nc = mechanism.module(teeth)   # the spec: module from perimeter and z
     stages = [_stage("non-circular pair", pair, teeth, _system(cutting, module_nc), cutting,
-                     (box, C))]
+                     (box, C), cache=cache)]
     cut(stages[-1].name)
     # circular gears: gearbox 2's 1:1 pair and train 1's set with converted ratio -1
     radii = planting_circular_radii(mechanism)
@@ -162,31 +190,32 @@ def planting_train(params, mechanism, progress=None) -> GearTrain:
     z = [int(round(2 * x / module)) for x in radii]
     D = C + a * np.array([math.cos(box), math.sin(box)])
     stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), mechanism.r, mechanism.r),
-                         (z[4], z[4]), system, cutting, (box, D), circular=True))
+                         (z[4], z[4]), system, cutting, (box, D), circular=True, cache=cache))
     cut(stages[-1].name)
     carrier = mechanism.phi0
     line = np.array([math.cos(carrier), math.sin(carrier)])
     first = _stage("train 1: sun to idler 1", circle_pair(("sun", "idler 1"), radii[0], radii[1]),
-                   (z[0], z[1]), system, cutting, (carrier, np.zeros(2)), circular=True)
+                   (z[0], z[1]), system, cutting, (carrier, np.zeros(2)), circular=True,
+                   cache=cache)
     cut(first.name)
     second = _stage("train 1: idler 1 to idler 2",
                     circle_pair(("idler 1", "idler 2"), radii[1], radii[2]), (z[1], z[2]), system,
                     cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated),
-                    circular=True)
+                    circular=True, cache=cache)
     cut(second.name)
     third = _stage("train 1: idler 2 to planet",
                    circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3]), (z[2], z[3]),
                    system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
-                   drive=_carry(second.generated), circular=True)
+                   drive=_carry(second.generated), circular=True, cache=cache)
     cut(third.name)
     return GearTrain(tuple(stages + [first, second, third]))
 
 
-def pricking_train(params, design, progress=None) -> GearTrain:
+def pricking_train(params, design, progress=None, cache=None) -> GearTrain:
     """The pricking mechanism's two non-circular stages at the outer dead centre.
 
     ``progress(done, total, stage name)``, optional, is called as each stage is cut (or found
-    not cuttable).
+    not cuttable). ``cache``: as for :func:`planting_train` (a stage not cuttable is not stored).
     """
     cut = _report_to(progress, 2)
     cutting = params.gears
@@ -204,7 +233,7 @@ def pricking_train(params, design, progress=None) -> GearTrain:
         system = _system(cutting, design.modules[index])
         try:
             stages.append(_stage(f"stage {index + 1}", pair, design.teeth[index], system, cutting,
-                                 (carrier, centre + index * link.a * line)))
+                                 (carrier, centre + index * link.a * line), cache=cache))
         except DesignError as error:  # reported with the gear and the reason; others go on
             failures += [(f"stage {index + 1}", problem) for problem in error.problems]
         cut(f"stage {index + 1}")

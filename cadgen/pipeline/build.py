@@ -330,10 +330,11 @@ def _drivetrain(run):
 
 
 def _teeth(run):
-    """Every gear cut with the process's backlash, then bored for its shaft (when the
-    drivetrain ran): the rim checks ride on the train (``GearTrain.rims``)."""
+    """Every gear cut with the process's backlash (or from the gear cache), then bored for its
+    shaft (when the drivetrain ran): the rim checks ride on the train (``GearTrain.rims``)."""
     from cadgen.gears.trains import planting_train, pricking_train
     from cadgen.machine.fits import process_fits
+    from cadgen.pipeline.gear_cache import cache_record, open_cache
 
     def cut(done, total, pair):
         run.progress.step("teeth", pair, steps=total)
@@ -344,7 +345,10 @@ def _teeth(run):
         params = params.model_copy(update={"gears": params.gears.model_copy(
             update={"backlash": fits.backlash})})
     make = pricking_train if params.mechanism == "pricking" else planting_train
-    train = make(params, run.values["kinematics"], progress=cut)
+    asked = getattr(run, "cache", None)   # a run made outside build() has no cache
+    cache = open_cache(asked)   # opened here: a scene without teeth never touches it
+    train = make(params, run.values["kinematics"], progress=cut, cache=cache)
+    run.gear_cache = cache_record(cache, asked)   # hits and misses, for the report
     if run.status("drivetrain") == "ok" and train.stages:
         from cadgen.machine.hubs import hub_train
 
@@ -432,7 +436,7 @@ def stage_warnings(params, stages) -> list:
 
 def build(params, output_root: Path | str | None = Path("outputs"), *, effects=None,
           case: str | None = None, steps: int | None = None,
-          preset: str | None = None, progress=None) -> BuildResult:
+          preset: str | None = None, progress=None, cache=True) -> BuildResult:
     """Build one validated design: the stages its effects need, then its outputs.
 
     Parameters
@@ -456,6 +460,10 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         files) and finishes, and for the pseudo-stage ``"write"`` (the output folder).
         In this process, never twice at once; the sweeps run beside the teeth, so their
         events interleave with the teeth's (``event.beside``). Nothing is printed.
+    cache : bool or path, default True
+        The gear cache (:mod:`cadgen.gears.cache`): True, the user's (see
+        :func:`cadgen.pipeline.gear_cache.cache_directory`); a path, that directory; False or
+        None, none (an unusable directory too). The report's ``gear_cache``: hits, misses.
 
     Raises
     ------
@@ -482,7 +490,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     warnings = stage_warnings(params, stages)
     run = _Build(params, stages, steps, progress)
     run.warnings = warnings
-    run.effects, run.case = effects, case
+    run.effects, run.case, run.cache = effects, case, cache
     run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
                                             for path, (value, source) in knobs.items()}}
     run.run(STAGE_FUNCTIONS)

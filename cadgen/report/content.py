@@ -164,6 +164,10 @@ def assemble_report(run, set_aside: dict) -> dict:
     report["check_warnings"] = check_warnings(report)
     report["accuracy_achieved"] = accuracy_achieved(params, report, values, ok)
     report["stages"] = [record.as_dict() for record in run.records]
+    # the gear cache's use in this build (cadgen.pipeline.gear_cache.cache_record): none
+    # when the teeth did not run
+    report["gear_cache"] = getattr(run, "gear_cache", None) or {
+        "used": False, "directory": None, "hits": 0, "misses": 0}
     report["failures"] = failures(report)
     report["passed"] = not report["failures"]
     report["versions"] = _versions()

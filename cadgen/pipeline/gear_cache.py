@@ -1,0 +1,92 @@
+"""Where the gear cache lives, and opening, clearing and describing it for the build and CLI.
+
+The cache itself (entries, keys, atomic writes) is :mod:`cadgen.gears.cache`; this module
+adds the one platform-dependent choice, the user's cache directory (platformdirs), so the
+gear code stays free of it.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+__all__ = ["CACHE_DIR_VARIABLE", "cache_directory", "open_cache", "cache_record", "clear_cache",
+           "cache_info"]
+
+#: Environment variable naming the gear cache's directory (tests, a shared scratch disk).
+CACHE_DIR_VARIABLE = "CADGEN_CACHE_DIR"
+
+
+def cache_directory() -> Path:
+    """The gear cache's directory: ``$CADGEN_CACHE_DIR`` when set, else
+    ``platformdirs.user_cache_dir("cadgen")/gears`` (``~/.cache/cadgen/gears`` on Linux)."""
+    chosen = os.environ.get(CACHE_DIR_VARIABLE)
+    if chosen:
+        return Path(chosen).expanduser()
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("cadgen")) / "gears"
+
+
+def open_cache(cache):
+    """The :class:`~cadgen.gears.cache.GearCache` a build's ``cache`` argument asks for, or None.
+
+    Parameters
+    ----------
+    cache : bool, path-like or None
+        True: :func:`cache_directory`; a path: that directory; False or None: no cache.
+        A directory that cannot be made or written gives None: a build never fails for
+        want of a cache, it only runs slower (the report's ``gear_cache`` says so).
+    """
+    if cache is None or cache is False:
+        return None
+    from cadgen.gears.cache import GearCache
+
+    directory = cache_directory() if cache is True else Path(cache)
+    try:
+        return GearCache(directory)
+    except OSError:
+        return None
+
+
+def cache_record(cache, asked=None) -> dict:
+    """The report's ``gear_cache``: ``{"used", "directory", "hits", "misses"}``.
+
+    ``asked`` is the build's ``cache`` argument, so a cache that could not be opened still
+    names the directory that was tried.
+    """
+    if cache is None:
+        tried = None
+        if asked is True:
+            tried = str(cache_directory())
+        elif asked not in (None, False):
+            tried = str(asked)
+        return {"used": False, "directory": tried, "hits": 0, "misses": 0}
+    return {"used": True, "directory": str(cache.directory), "hits": cache.hits,
+            "misses": cache.misses}
+
+
+def clear_cache(directory=None) -> dict:
+    """Remove every cached gear: ``{"directory", "entries", "bytes"}`` removed.
+
+    ``directory`` defaults to :func:`cache_directory`; a missing one has nothing to remove
+    (it is not created).
+    """
+    from cadgen.gears.cache import GearCache
+
+    directory = Path(directory) if directory is not None else cache_directory()
+    if not directory.is_dir():
+        return {"directory": str(directory), "entries": 0, "bytes": 0}
+    entries, freed = GearCache(directory, create=False).clear()
+    return {"directory": str(directory), "entries": entries, "bytes": freed}
+
+
+def cache_info(directory=None) -> dict:
+    """The gear cache's ``{"directory", "exists", "entries", "bytes"}`` (nothing created)."""
+    from cadgen.gears.cache import GearCache
+
+    directory = Path(directory) if directory is not None else cache_directory()
+    if not directory.is_dir():
+        return {"directory": str(directory), "exists": False, "entries": 0, "bytes": 0}
+    entries, size = GearCache(directory, create=False).stats()
+    return {"directory": str(directory), "exists": True, "entries": entries, "bytes": size}

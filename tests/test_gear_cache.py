@@ -1,0 +1,284 @@
+"""The gear cache (cadgen.gears.cache, cadgen.pipeline.gear_cache): cached builds write the same
+bytes, bad entries are recomputed, concurrent writers cannot corrupt an entry."""
+
+import dataclasses
+import multiprocessing
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cadgen
+from cadgen.cli import main
+from cadgen.gears.cache import _HEADER, GearCache, stage_key
+
+REPO = Path(__file__).resolve().parents[1]
+PAPER = REPO / "params" / "xin2024-planter.toml"
+#: What the byte-for-byte comparison covers: every cut gear's DXF and the pitch curves.
+EFFECTS = ["teeth", "dxf", "curves"]
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return cadgen.load_params(PAPER)
+
+
+def _files(folder: Path) -> dict:
+    """Every file under gears/ and curves/ of a build's folder: {relative path: bytes}."""
+    return {str(p.relative_to(folder)): p.read_bytes()
+            for sub in ("gears", "curves") for p in sorted((folder / sub).rglob("*"))
+            if p.is_file()}
+
+
+def _build(params, out: Path, cache):
+    result = cadgen.build(params, out, effects=EFFECTS, cache=cache)
+    assert result.report["stages"][-1]["status"] == "ok", result.report["stages"]
+    return result.report["gear_cache"], _files(out / params.name)
+
+
+@pytest.fixture(scope="module")
+def uncached(paper, tmp_path_factory):
+    """The paper design's gear files cut with no cache: the reference bytes."""
+    record, files = _build(paper, tmp_path_factory.mktemp("uncached"), cache=False)
+    assert record == {"used": False, "directory": None, "hits": 0, "misses": 0}
+    assert any(name.startswith("gears/") for name in files)
+    assert any(name.startswith("curves/") for name in files)
+    return files
+
+
+def test_cached_builds_write_the_bytes_an_uncached_build_writes(paper, uncached, tmp_path):
+    cache = tmp_path / "cache"
+    cold, cold_files = _build(paper, tmp_path / "cold", cache)
+    assert cold == {"used": True, "directory": str(cache), "hits": 0, "misses": 5}
+    warm, warm_files = _build(paper, tmp_path / "warm", cache)
+    assert (warm["hits"], warm["misses"]) == (5, 0)
+    assert cold_files.keys() == warm_files.keys() == uncached.keys()
+    for name, data in uncached.items():
+        assert cold_files[name] == data, name
+        assert warm_files[name] == data, name
+    assert GearCache(cache).stats()[0] == 5
+
+
+def _equal(a, b, path="stage"):
+    """Recursive equality, arrays element by element (exactly, NaN equal to NaN)."""
+    if isinstance(a, np.ndarray):
+        assert isinstance(b, np.ndarray) and a.dtype == b.dtype, path
+        np.testing.assert_array_equal(a, b, err_msg=path)
+    elif type(a).__name__ == "ArcLengthCurve":   # splines inside: compared by their values
+        s = np.linspace(0.0, a.length, 997)
+        assert type(b) is type(a) and (a.length, a.reversed) == (b.length, b.reversed), path
+        np.testing.assert_array_equal(a.frame(s), b.frame(s), err_msg=path)
+        np.testing.assert_array_equal(a.curvature(s), b.curvature(s), err_msg=path)
+        np.testing.assert_array_equal(a.arc_of_source(s), b.arc_of_source(s), err_msg=path)
+    elif dataclasses.is_dataclass(a) and not isinstance(a, type):
+        assert type(a) is type(b), path
+        for f in dataclasses.fields(a):
+            _equal(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}")
+    elif isinstance(a, (list, tuple)):
+        assert type(a) is type(b) and len(a) == len(b), path
+        for k, (x, y) in enumerate(zip(a, b)):
+            _equal(x, y, f"{path}[{k}]")
+    elif isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for k in a:
+            _equal(a[k], b[k], f"{path}[{k!r}]")
+    elif isinstance(a, float) and np.isnan(a):
+        assert np.isnan(b), path
+    else:
+        assert a == b, path
+
+
+def test_a_loaded_stage_equals_the_computed_one_in_every_array(paper, tmp_path):
+    from cadgen.design import build_mechanism
+    from cadgen.gears.trains import planting_train
+
+    mechanism = build_mechanism(paper)
+    cache = GearCache(tmp_path)
+    computed = planting_train(paper, mechanism, cache=cache)
+    loaded = planting_train(paper, mechanism, cache=cache)
+    assert (cache.hits, cache.misses) == (5, 5)
+    for a, b in zip(computed.stages, loaded.stages, strict=True):
+        # the pair's contact functions are closures (each train makes its own): the loaded
+        # stage has the caller's pair, and every other field equal
+        assert b.generated.pair.names == a.generated.pair.names
+        _equal(*(dataclasses.replace(s, generated=dataclasses.replace(s.generated, pair=None),
+                                     meshing=dataclasses.replace(s.meshing, seconds=0.0))
+                 for s in (a, b)), a.name)
+
+
+def test_a_grid_over_the_planter_length_recuts_no_gear(paper, tmp_path):
+    text = PAPER.read_text(encoding="utf-8")
+    assert "L2 = 190.0" in text
+    shorter = cadgen.validate_text(text.replace("L2 = 190.0", "L2 = 180.0", 1))
+    assert shorter.planter.L2 == 180.0
+    cache = tmp_path / "cache"
+    first, _ = _build(paper, tmp_path / "190", cache)
+    second, _ = _build(shorter, tmp_path / "180", cache)
+    assert (first["hits"], first["misses"]) == (0, 5)
+    assert (second["hits"], second["misses"]) == (5, 0)
+
+
+def test_a_key_changes_with_what_determines_the_stage():
+    from cadgen.gears.pairs import circle_pair
+    from cadgen.gears.teeth import ToothSystem
+
+    options = dict(flank_points=48, bore_radius=5.0, force_shaper=False, poses=32, span=None,
+                   circular=True)
+    pair = circle_pair(("a", "b"), 20.0, 30.0)
+    key = stage_key("s", pair, (20, 30), ToothSystem(2.0), **options)
+    assert key == stage_key("s", circle_pair(("a", "b"), 20.0, 30.0), (20, 30), ToothSystem(2.0),
+                            **options)
+    others = [stage_key("t", pair, (20, 30), ToothSystem(2.0), **options),
+              stage_key("s", circle_pair(("a", "b"), 20.0, 30.000001), (20, 30),
+                        ToothSystem(2.0), **options),
+              stage_key("s", pair, (20, 31), ToothSystem(2.0), **options),
+              stage_key("s", pair, (20, 30), ToothSystem(2.0, backlash=0.01), **options),
+              stage_key("s", pair, (20, 30), ToothSystem(2.0), **{**options, "poses": 33}),
+              stage_key("s", pair, (20, 30), ToothSystem(2.0), **{**options, "bore_radius": 6})]
+    assert len({key, *others}) == len(others) + 1
+
+
+@pytest.mark.parametrize("damage", ["truncated", "flipped"])
+def test_a_bad_entry_is_a_miss_and_the_build_recomputes_it(paper, uncached, tmp_path, damage):
+    cache = tmp_path / "cache"
+    _build(paper, tmp_path / "cold", cache)
+    entries = sorted(cache.glob("??/*.gear"))
+    assert len(entries) == 5
+    victim = entries[0]
+    data = victim.read_bytes()
+    if damage == "truncated":
+        victim.write_bytes(data[: len(data) // 2])
+    else:
+        position = _HEADER.size + (len(data) - _HEADER.size) // 2   # a payload byte
+        victim.write_bytes(data[:position] + bytes([data[position] ^ 0x01])
+                           + data[position + 1:])
+    store = GearCache(cache)
+    assert store.get(victim.stem) is None and (store.hits, store.misses) == (0, 1)
+    assert not victim.exists()      # deleted, so the next build stores a good one
+    victim.write_bytes(b"CGGEAR")   # shorter than a header: unreadable, still no exception
+    record, files = _build(paper, tmp_path / "again", cache)
+    assert (record["hits"], record["misses"]) == (4, 1)
+    assert files == uncached
+    assert GearCache(cache).get(victim.stem) is not None   # recomputed and stored again
+
+
+def test_get_never_raises_for_a_missing_or_garbage_entry(tmp_path):
+    store = GearCache(tmp_path)
+    key = "ab" * 32
+    assert store.get(key) is None
+    store.path(key).parent.mkdir()
+    for garbage in (b"", b"\x00" * 200, os.urandom(5000)):
+        store.path(key).write_bytes(garbage)
+        assert store.get(key) is None
+    assert store.put(key, {"x": np.arange(3)}) and store.get(key)["x"].tolist() == [0, 1, 2]
+    with pytest.raises(ValueError, match="hexadecimal"):
+        store.get("../../etc/passwd")
+    assert store.put("cd" * 32, lambda: None) is False   # does not pickle: not stored
+
+
+# ------------------------------------------------------------------------ concurrent writers
+KEY = "5a" * 32
+SIZE = 400_000
+
+
+def _writer(directory, mark, times):
+    store = GearCache(directory)
+    for _ in range(times):
+        assert store.put(KEY, {"mark": mark, "values": np.full(SIZE, float(mark))})
+
+
+def _context():
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+
+
+def test_concurrent_writers_of_one_key_never_show_a_reader_a_partial_entry(tmp_path):
+    context = _context()
+    writers = [context.Process(target=_writer, args=(str(tmp_path), mark, 50))
+               for mark in (1, 2)]
+    for writer in writers:
+        writer.start()
+    store, whole, deadline = GearCache(tmp_path), 0, time.monotonic() + 120
+    while any(w.is_alive() for w in writers) and time.monotonic() < deadline:
+        value = store.get(KEY)
+        if value is None:
+            continue
+        # a whole entry of one writer: never a mixture of the two, never short
+        assert value["mark"] in (1, 2) and value["values"].shape == (SIZE,)
+        assert (value["values"] == value["mark"]).all()
+        whole += 1
+    for writer in writers:
+        writer.join(60)
+        assert writer.exitcode == 0
+    assert store.get(KEY)["values"].shape == (SIZE,)
+    assert whole > 0
+    assert not list(tmp_path.glob("??/*.tmp"))   # no temporary file left behind
+    assert store.stats()[0] == 1
+
+
+# ------------------------------------------------------------------------ command line
+def test_cache_clear_and_info_on_the_command_line(paper, tmp_path, monkeypatch, capsys):
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("CADGEN_CACHE_DIR", str(cache))
+    assert cadgen.cache_directory() == cache
+    result = cadgen.build(paper, None, effects=["teeth"])   # the default: the cache
+    assert result.report["gear_cache"]["directory"] == str(cache)
+    assert main(["cache", "info"]) == 0
+    out = capsys.readouterr().out
+    assert str(cache) in out and "entries:   5" in out
+    assert main(["cache", "clear"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("removed 5 gear cache entries (") and str(cache) in out
+    assert cache.is_dir() and not list(cache.iterdir())
+    assert cadgen.cache_info()["entries"] == 0
+    assert main(["cache", "clear"]) == 0 and "removed 0 " in capsys.readouterr().out
+
+
+def test_no_cache_builds_use_no_cache(paper, tmp_path, monkeypatch, capsys):
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("CADGEN_CACHE_DIR", str(cache))
+    assert main(["build", str(PAPER), "--effects", "teeth", "--no-cache",
+                 "--output-dir", str(tmp_path / "out")]) in (0, 1)
+    import json
+
+    report = json.loads((tmp_path / "out" / paper.name / "report.json").read_text())
+    assert report["gear_cache"] == {"used": False, "directory": None, "hits": 0, "misses": 0}
+    assert not cache.exists()
+    capsys.readouterr()
+
+
+def test_an_unusable_cache_directory_builds_without_it(paper, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    record = cadgen.build(paper, None, effects=["teeth"], cache=blocker / "gears").report[
+        "gear_cache"]
+    assert record == {"used": False, "directory": str(blocker / "gears"), "hits": 0,
+                      "misses": 0}
+
+
+def test_a_scene_without_teeth_never_touches_the_cache(paper, tmp_path):
+    report = cadgen.build(paper, None, effects=["metrics"], cache=tmp_path / "c").report
+    assert report["gear_cache"]["used"] is False and not (tmp_path / "c").exists()
+
+
+def test_batch_no_cache_reaches_each_designs_build(monkeypatch, tmp_path, capsys):
+    import argparse
+
+    import cadgen.batch as batch
+
+    parser = batch.add_batch_arguments(argparse.ArgumentParser())
+    assert parser.parse_args([]).no_cache is False
+    seen = []
+
+    def run_batch(jobs, output_root, **options):   # records what the workers would get
+        seen.append(options.get("build_kwargs"))
+        return []
+
+    monkeypatch.setattr(batch, "run_batch", run_batch)
+    monkeypatch.setattr(batch, "write_summary", lambda summaries, root: ("a.csv", "a.html"))
+    for argv in ([str(PAPER), "--no-cache"], [str(PAPER)]):
+        batch.main_batch(parser.parse_args([*argv, "--output-dir", str(tmp_path)]))
+    assert seen == [{"cache": False}, None]   # the default leaves a custom build's options be
+    capsys.readouterr()
