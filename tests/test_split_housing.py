@@ -75,7 +75,10 @@ def test_base_and_cover_disjoint_and_volume_closed_form(housing):
     height = 35.0 + floor + roof
     low, high = built.flange_z
     ring = shapely.Polygon(flange).difference(shapely.Polygon(outer))
-    bolts = shapely.union_all([shapely.Polygon(circle(2.25, SEGMENTS, xy))
+    # a clearance hole is no fit: its polygon is within 0.01 mm of its circle, no finer
+    sides = built.bolt_segments
+    assert 12 <= sides <= SEGMENTS and 2.25 * (1 / math.cos(math.pi / sides) - 1) <= 0.01
+    bolts = shapely.union_all([shapely.Polygon(circle(2.25, sides, xy))
                                for xy in built.bolt_positions])
     assert bolts.within(ring)     # every bolt hole lies in the flange, clear of the wall
     expected = (shapely.Polygon(outer).area * height + (ring.area - bolts.area) * (high - low)

@@ -526,7 +526,7 @@ def segment_housing(housing, cuts, *, segments: int, name: str = "housing") -> S
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import circle
 
-    flange_holes = [extrude(circle(hole / 2, housing.segments, xy),
+    flange_holes = [extrude(circle(hole / 2, housing.bolt_segments, xy),
                             housing.flange_z[1] - housing.flange_z[0], z0=housing.flange_z[0],
                             path=f"{name}.flange_bolts")
                     for xy in np.asarray(housing.bolt_positions, dtype=float).reshape(-1, 2)]
