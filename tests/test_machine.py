@@ -205,8 +205,6 @@ def test_every_seat_fits_its_shaft_and_the_process(bundled):
 
 
 def test_planting_names_positions_and_stack():
-    from cadgen.solids.housings import planting_shells
-    from cadgen.solids.planting import layout_of
 
     params = load_params(PAPER)
     mechanism = build_mechanism(params)
@@ -222,10 +220,13 @@ def test_planting_names_positions_and_stack():
     assert shaft.name == "E" and shaft.xy == pytest.approx((a + 2 * r, 0.0))
     c2 = next(s for s in train.shafts if s.name == "C" and s.side == 2)
     assert c2.xy == pytest.approx((0.0, -mechanism.carrier_radii["C"]), abs=1e-9)
-    layout = layout_of(params, mechanism, planting_shells(params, mechanism), None)
-    assert train.stacks["gearbox1"].cavity_height == pytest.approx(layout.box1_height)
-    assert train.stacks["gearbox2"].cavity_height == pytest.approx(layout.box2_height)
-    assert mount.z_bottom == pytest.approx(layout.layer2 - layout.box2_floor)
+    # by hand from the file: faces 25 mm (gears.face_width), gaps 2 mm (housing.axial_gap);
+    # gearbox 1 one layer, gearbox 2 two, a gap below, between and above the layers
+    face, gap = params.gears.face_width, params.housing.axial_gap
+    assert (face, gap) == (25.0, 2.0)
+    assert train.stacks["gearbox1"].cavity_height == pytest.approx(face + 2 * gap)
+    assert train.stacks["gearbox2"].cavity_height == pytest.approx(2 * face + 3 * gap)
+    assert mount.z_bottom == pytest.approx(2 * gap + face)     # gear E in the second layer
     o = next(s for s in train.shafts if s.name == "O")
     assert o.extends_below == 2 * o.diameter + 20 and o.seats[0].through
     assert not o.seats[1].through

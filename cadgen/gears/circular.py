@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from kinematics.errors import DesignError
 
-__all__ = ["MIN_CIRCULAR_TEETH", "circular_module", "planting_circular_radii"]
+__all__ = ["MIN_CIRCULAR_TEETH", "circular_module", "planting_circular_radii", "planting_modules"]
 
 #: Circular gears get at least this many teeth: a standard rack undercuts fewer (2/sin^2(20 deg)).
 MIN_CIRCULAR_TEETH = 17
@@ -99,3 +99,20 @@ def planting_circular_radii(mechanism) -> list:
     planet) and gearbox 2's 1:1 gear ``r``."""
     R = mechanism.R
     return [R, R * mechanism.i12, R * mechanism.i13, R, mechanism.r]
+
+
+def planting_modules(mechanism, teeth: int, requested=None) -> tuple:
+    """``(non-circular module, circular module)`` of a planting design, mm.
+
+    The non-circular one from the pitch curve's perimeter and ``teeth``; the circular
+    one by :func:`circular_module` (``requested``: the file's ``gears.circular_module``).
+    When no whole-tooth circular module exists the teeth stage says so; the housings,
+    shafts and kinematic envelopes meanwhile size the circular gears as if they had
+    ``requested`` or else the non-circular module.
+    """
+    module_nc = float(mechanism.module(teeth))
+    try:
+        module_c = circular_module(planting_circular_radii(mechanism), requested)
+    except DesignError:
+        module_c = requested or module_nc
+    return module_nc, float(module_c)

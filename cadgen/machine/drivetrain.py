@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 from kinematics.errors import Problem
 
+from cadgen.gears.circular import planting_modules
 from cadgen.machine.bearings import select_bearing
 from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
 from cadgen.machine.fits import process_fits
@@ -93,28 +94,11 @@ class _Sized:
 
 
 # ------------------------------------------------------------------ layouts
-def _planting_modules(params, mechanism) -> tuple:
-    """(non-circular module, circular module), as the housings and solids take them.
-
-    The same rule as :func:`cadgen.solids.housings.planting_shells` (which this floor
-    may not import): with no whole-tooth circular module, the non-circular one.
-    """
-    from kinematics.errors import DesignError
-
-    from cadgen.gears.circular import circular_module, planting_circular_radii
-
-    module_nc = float(mechanism.module(params.pitch_curve.teeth))
-    try:
-        module_c = circular_module(planting_circular_radii(mechanism), params.gears.circular_module)
-    except DesignError:
-        module_c = params.gears.circular_module or module_nc
-    return module_nc, float(module_c)
-
-
 def _planting_axes(params, mechanism) -> tuple:
     housing, gears = params.housing, params.gears
     gap = housing.axial_gap
-    module_nc, module_c = _planting_modules(params, mechanism)
+    module_nc, module_c = planting_modules(mechanism, params.pitch_curve.teeth,
+                                           gears.circular_module)
     face_nc, face_c = gears.face_width_for(module_nc), gears.face_width_for(module_c)
     box1 = face_c + 2 * gap
     box2 = face_nc + face_c + 3 * gap

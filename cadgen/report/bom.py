@@ -27,10 +27,6 @@ __all__ = ["BOM_COLUMNS", "bom_rows", "bom_csv", "bolt_set"]
 BOM_COLUMNS = ("item", "source", "part", "description", "designation", "material", "process",
                "quantity", "mass_each_kg", "file")
 
-#: Thread pitch of the coarse ISO metric threads (ISO 261), mm: the screw's end must stand
-#: at least two pitches out of the nut.
-_PITCH = {"M3": 0.5, "M4": 0.7, "M5": 0.8, "M6": 1.0, "M8": 1.25, "M10": 1.5, "M12": 1.75}
-
 
 def bolt_set(thread: str, grip: float) -> dict:
     """The screw, nut and washers that clamp ``grip`` mm of flange: designations and length.
@@ -38,10 +34,12 @@ def bolt_set(thread: str, grip: float) -> dict:
     The screw is the shortest ISO 4762 standard length through the grip, two washers
     (ISO 7089), the nut (ISO 4032) and two thread pitches beyond it.
     """
-    from cadgen.machine.catalogue import nut, screw_length, washer
+    from cadgen.machine.catalogue import nut, screw_length, socket_screw, washer
 
     nut_row, washer_row = nut(thread), washer(thread)
-    needed = grip + 2 * float(washer_row["h"]) + float(nut_row["m"]) + 2 * _PITCH[thread]
+    # the screw's end stands at least two thread pitches out of the nut
+    needed = (grip + 2 * float(washer_row["h"]) + float(nut_row["m"])
+              + 2 * socket_screw(thread)["pitch"])
     length = screw_length(thread, needed)
     size = thread.removeprefix("M")
     return {"screw": f"ISO 4762 {thread} x {length:g} - 8.8", "screw_length": length,

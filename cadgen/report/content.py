@@ -190,9 +190,7 @@ def machine_section(params, drivetrain, train=None) -> dict:
                      "warning_limit_mm": float(rim.warning_limit), "module_mm": float(rim.module),
                      "passed": bool(rim.passed),
                      "where_mm": [list(map(float, point)) for point in rim.where],
-                     "problems": [p.as_dict() if hasattr(p, "as_dict") else
-                                  {"path": p.path, "code": p.code, "message": p.message}
-                                  for p in rim.problems]})
+                     "problems": [p.as_dict() for p in rim.problems]})
     section["hubs"] = rims
     return section
 

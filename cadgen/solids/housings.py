@@ -14,10 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from kinematics.clearance import HousingCircle
-from kinematics.errors import DesignError
 from kinematics.planting import PlantingMechanism
 
-from cadgen.gears.circular import circular_module, planting_circular_radii
+from cadgen.gears.circular import planting_modules
 
 __all__ = ["ShellSize", "planting_shells", "housing_circles", "envelope_circles"]
 
@@ -59,13 +58,8 @@ def planting_shells(params, mechanism) -> dict:
     circular train.
     """
     housing = params.housing
-    module_nc = mechanism.module(params.pitch_curve.teeth)
-    try:
-        module_c = circular_module(planting_circular_radii(mechanism), params.gears.circular_module)
-    except DesignError:
-        # no whole-tooth module: the teeth stage says so; the envelopes (and the kinematic
-        # metrics) size the circular gears as if they had the non-circular gears' module
-        module_c = params.gears.circular_module or module_nc
+    module_nc, module_c = planting_modules(mechanism, params.pitch_curve.teeth,
+                                           params.gears.circular_module)
     size = {}
     for name, module in (("gearbox1", module_c), ("gearbox2", max(module_nc, module_c))):
         wall = housing.wall_for(module)

@@ -21,13 +21,11 @@ import math
 
 from cadgen.solids.parts import Part, planar_transform
 
-__all__ = ["BOLT_BY_WALL", "ISO273_MEDIUM", "housing_bolt", "stack_housing", "housing_parts",
+__all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "housing_parts",
            "printed_housing_parts", "shaft_part", "shaft_ends"]
 
 #: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
 BOLT_BY_WALL = ((4.0, "M3"), (6.0, "M4"), (8.0, "M5"))
-#: ISO 273 medium-series clearance holes (mm), used only when the catalogue is not available.
-ISO273_MEDIUM = {"M3": 3.4, "M4": 4.5, "M5": 5.5, "M6": 6.6, "M8": 9.0, "M10": 11.0}
 
 
 def housing_bolt(params, wall: float) -> tuple:
@@ -43,11 +41,9 @@ def housing_bolt(params, wall: float) -> tuple:
     size = getattr(params.housing, "bolt_size", None)
     if size is None:
         size = next((bolt for below, bolt in BOLT_BY_WALL if wall < below), "M6")
-    try:
-        from cadgen.machine.catalogue import clearance_hole
-        from cadgen.machine.fits import process_fits
-    except ImportError:   # the machine package not installed: the ISO 273 medium table
-        return size, ISO273_MEDIUM[size]
+    from cadgen.machine.catalogue import clearance_hole
+    from cadgen.machine.fits import process_fits
+
     fits = process_fits(params.manufacturing.process)
     return size, clearance_hole(size, fits.bolt_hole_series) + fits.bolt_hole_extra
 

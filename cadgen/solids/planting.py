@@ -64,61 +64,46 @@ class PlantingLayout:
     arm_thickness: float
     tube_axis: float        # z of the duckbill tube's axis
     tube_radius: float      # outer
-    box1_floor_wall: float = None   # end walls (None: the side wall, a closed shell's)
-    box1_roof_wall: float = None
-    box2_floor_wall: float = None
-    box2_roof_wall: float = None
-    box1_layers: tuple = ()         # absolute z of each gear layer's bottom (): from the gap
-    box2_layers: tuple = ()
-
-    def __post_init__(self):
-        for box in ("box1", "box2"):
-            for end in ("floor", "roof"):
-                if getattr(self, f"{box}_{end}_wall") is None:
-                    object.__setattr__(self, f"{box}_{end}_wall", getattr(self, f"{box}_wall"))
+    box1_floor_wall: float          # end walls: as thick as their deepest bearing seat
+    box1_roof_wall: float
+    box2_floor_wall: float
+    box2_roof_wall: float
+    box1_layers: tuple              # absolute z of each gear layer's bottom
+    box2_layers: tuple
 
     @property
     def layer0(self) -> float:
         """Bottom of gearbox 1's gear layer (train 1)."""
-        return self.box1_layers[0] if self.box1_layers else self.box1_floor + self.gap
+        return self.box1_layers[0]
 
     @property
     def layer1(self) -> float:
         """Bottom of gearbox 2's first gear layer (the non-circular pair)."""
-        return self.box2_layers[0] if self.box2_layers else self.box2_floor + self.gap
+        return self.box2_layers[0]
 
     @property
     def layer2(self) -> float:
         """Bottom of gearbox 2's second gear layer (the 1:1 pair)."""
-        if len(self.box2_layers) > 1:
-            return self.box2_layers[1]
-        return self.layer1 + self.face_nc + self.gap
+        return self.box2_layers[1]
 
     @property
     def z_range(self) -> tuple:
         return (self.box1_floor - self.box1_floor_wall, self.tube_axis + self.tube_radius)
 
 
-def layout_of(params, mechanism, shells, cam_design, drivetrain=None) -> PlantingLayout:
-    """The axial stack; with a drivetrain, its housings' end walls, cavities and gear layers.
+def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayout:
+    """The axial stack from the drivetrain's housing stacks: end walls, cavities, gear layers.
 
     Gearbox 1's cavity floor is at z = 0; gearbox 2's floor wall starts ``gap`` above
-    gearbox 1's roof's outer face, the cam ``gap`` above gearbox 2's roof's. Without
-    a drivetrain every end wall is the side wall (closed shells) and the layers are
-    ``gap`` apart.
+    gearbox 1's roof's outer face, the cam ``gap`` above gearbox 2's roof's.
     """
     gap = params.housing.axial_gap
     face_nc = params.gears.face_width_for(mechanism.module(params.pitch_curve.teeth))
     face_c = params.gears.face_width_for(shells["gearbox1"].module)
     w1, w2 = shells["gearbox1"].wall, shells["gearbox2"].wall
-    if drivetrain is not None:
-        stack1, stack2 = drivetrain.stacks["gearbox1"], drivetrain.stacks["gearbox2"]
-        walls = (stack1.floor_wall, stack1.roof_wall, stack2.floor_wall, stack2.roof_wall)
-        box1_height, box2_height = stack1.cavity_height, stack2.cavity_height
-    else:
-        stack1 = stack2 = None
-        walls = (w1, w1, w2, w2)
-        box1_height, box2_height = face_c + 2 * gap, face_nc + face_c + 3 * gap
+    stack1, stack2 = drivetrain.stacks["gearbox1"], drivetrain.stacks["gearbox2"]
+    walls = (stack1.floor_wall, stack1.roof_wall, stack2.floor_wall, stack2.roof_wall)
+    box1_height, box2_height = stack1.cavity_height, stack2.cavity_height
     box2_floor = box1_height + walls[1] + gap + walls[2]
     cam_bottom = box2_floor + box2_height + walls[3] + gap
     cam_thickness = params.cam.thickness if cam_design is not None else 0.0
@@ -127,8 +112,8 @@ def layout_of(params, mechanism, shells, cam_design, drivetrain=None) -> Plantin
     tube_radius = _tube_radius(params, cam_design)
     # the tube stands beside the arm plate, overlapping it by one shell wall so they join
     tube_axis = arm_bottom + arm_thickness + tube_radius - params.planter.shell_wall
-    layers1 = tuple(z for z, _ in stack1.layers) if stack1 is not None else ()
-    layers2 = tuple(box2_floor + z for z, _ in stack2.layers) if stack2 is not None else ()
+    layers1 = tuple(z for z, _ in stack1.layers)
+    layers2 = tuple(box2_floor + z for z, _ in stack2.layers)
     return PlantingLayout(face_nc, face_c, gap, 0.0, box1_height, w1, box2_floor, box2_height, w2,
                           cam_bottom, cam_thickness, arm_bottom, arm_thickness, tube_axis,
                           tube_radius, *walls, layers1, layers2)
