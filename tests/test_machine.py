@@ -201,7 +201,8 @@ def test_every_seat_fits_its_shaft_and_the_process(bundled):
             assert wall >= seat.bearing.width + 2.0
     report = drivetrain_report(train)
     json.dumps(report)
-    assert {p["code"] for p in report["problems"]} <= {"key_overloaded"}
+    # the bundled designs' faces are wide enough for their keys: no check fails
+    assert report["problems"] == [] and report["passed"]
 
 
 def test_planting_names_positions_and_stack():
