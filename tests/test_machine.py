@@ -286,3 +286,13 @@ def test_a_short_life_target_is_met_and_a_long_one_is_named(tmp_path):
     _, train = _variant(tmp_path, PAPER, "machine", bearing_life_min_h="900000.0")
     short = [p for p in train.problems if p.code == "bearing_life_short"]
     assert short and all(p.path == "machine.bearing_life_min_h" for p in short)
+
+
+def test_a_cam_bore_smaller_than_the_e_shafts_hole_is_named(tmp_path):
+    """The cam is fixed to gearbox 2 and the E shaft turns in it: a 12 mm bore on the 15 mm
+    shaft (its hole 15 + 1.0 mm running clearance, machined) is a failing check; 16 mm is not."""
+    params, train = _variant(tmp_path, PAPER, "cam", bore_diameter="12.0")
+    (problem,) = [p for p in train.problems if p.code == "cam_bore_too_small"]
+    assert problem.path == "cam.bore_diameter" and "16 mm" in problem.message
+    _, train = _variant(tmp_path, PAPER, "cam", bore_diameter="16.0")
+    assert not [p for p in train.problems if p.code == "cam_bore_too_small"]

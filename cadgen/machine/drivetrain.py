@@ -94,6 +94,24 @@ class _Sized:
 
 
 # ------------------------------------------------------------------ layouts
+def _cam_bore_problems(params, shafts) -> list:
+    """A cam bore given in the file that the E shaft does not turn freely in (planting).
+
+    The cam is fixed to gearbox 2 and the E shaft turns inside it, so its bore must be at
+    least the shaft's running hole (left out, the bore is that hole)."""
+    given = getattr(getattr(params, "cam", None), "bore_diameter", None)
+    if params.mechanism != "planting" or given is None:
+        return []
+    hole = next((seat.hole_diameter for shaft in shafts if shaft.name == "E"
+                 for seat in shaft.seats if seat.wall == "roof" and seat.through), None)
+    if hole is None or given >= hole - 1e-9:
+        return []
+    return [Problem("cam.bore_diameter", "cam_bore_too_small",
+                    f"the cam's bore of {given:g} mm is smaller than the {hole:g} mm the E shaft "
+                    "turns in (its diameter plus the running clearance): leave cam.bore_diameter "
+                    "out, or give at least that")]
+
+
 def _planting_axes(params, mechanism) -> tuple:
     housing, gears = params.housing, params.gears
     gap = housing.axial_gap
@@ -376,6 +394,7 @@ def drivetrain(params, design) -> Drivetrain:
                             axis.loads.speed_rpm, mounts, tuple(seats),
                             float(axis.below(d)) if axis.floor_through else 0.0,
                             axis.above if axis.roof_through else 0.0, axis.note))
+    problems += _cam_bore_problems(params, shafts)
     if not converged:
         problems.append(Problem("machine", "drivetrain_not_settled",
                                 f"bearings and end walls still changed after {iterations} "
