@@ -2,17 +2,22 @@
 
 Run:  python -m benchmarks.performance [--output docs/performance.md] [--quick]
 
-1. **Full build** of the paper's planting design with every effect (``cadgen build``
-   in a fresh interpreter: the whole process, imports included), best and median
-   of 3, with the stage times of the last run, with the gear cache cold (emptied
-   before each run) and warm (its entries from the run before). Aim: under 3 s on
-   2 cores, cold. The benchmark's cache is a temporary directory (``CADGEN_CACHE_DIR``),
-   never the user's.
-2. **Metrics-only scene** (``--effects metrics``), best and median of 5. Aim: 0.5 s.
-3. **Certified sweep against a plain 3600-pose scan**, both clearances of the
+1. **Against the peer, interleaved**: in each of ``--rounds`` rounds (default 5), in turn,
+   ncgears 0.3.1 generating one 24-tooth pair as its own command line does
+   (``python -m ncgears --centrode "30 + 8*cos(phi)" --teeth 24 --module 2.5``, whole
+   process, in its own virtualenv: :mod:`benchmarks.peer_ncgears`), then the full build
+   of the paper's planting design with every effect (``cadgen build`` in a fresh
+   interpreter, whole process, imports included) with the gear cache cold (emptied
+   before the run), the same with the cache warm (the cold run's entries), and the
+   metrics-only scene (``--effects metrics``). Medians, spreads (min-max) and the ratio
+   of each median to the peer's. Issue 15's aims: the cold full build <= 0.35 x the
+   peer (0.25 x hoped), metrics only <= 0.05 x. The benchmark's gear cache is a temporary
+   directory (``CADGEN_CACHE_DIR``), never the user's. The stage times of the last cold
+   and warm builds are printed as a second table.
+2. **Certified sweep against a plain 3600-pose scan**, both clearances of the
    paper's assembly with the build's own scenes and bounds (blades included), each
    against a reference (the certified sweep at ``atol`` 1e-10 mm): time, ratio, error.
-4. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
+3. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
    design (every effect), on 1 and on 2 worker processes: designs per minute and
    the speed-up.
 
@@ -56,23 +61,51 @@ def _empty_cache() -> None:
     shutil.rmtree(_CACHE["directory"], ignore_errors=True)
 
 
-def build_times(root: Path, repeat: int, effects=None, cache: str = "cold") -> dict:
-    """Wall times of ``repeat`` builds; ``cache`` "cold" empties the gear cache before each,
-    "warm" fills it with one build first."""
-    runs = []
-    if cache == "warm":
+PEER_ARGS = ("-m", "ncgears", "--centrode", "30 + 8*cos(phi)", "--teeth", "24",
+             "--module", "2.5")
+
+
+def _peer(python: Path) -> float:
+    """Wall time (s) of the peer's command line in a fresh interpreter (in a scratch folder:
+    it writes its files to the working directory)."""
+    with tempfile.TemporaryDirectory() as scratch:
+        start = time.perf_counter()
+        done = subprocess.run([str(python), *PEER_ARGS], cwd=scratch, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True)
+        seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        raise RuntimeError(f"ncgears failed (exit {done.returncode}): {done.stderr.strip()}")
+    return seconds
+
+
+def _stages(folder: Path) -> dict:
+    report = json.loads((folder / "xin2024-planter" / "report.json").read_text())
+    return {s["stage"]: s["seconds"] for s in report["stages"]}
+
+
+def interleaved_rounds(root: Path, rounds: int, peer_python: Path | None) -> dict:
+    """``{scene: [wall seconds per round]}`` for the peer and the three builds, run in turn in
+    each round, and ``"stages"``: the stage times of the last cold and warm builds."""
+    times = {"peer": [], "cold": [], "warm": [], "metrics": []}
+    stages = {}
+    args = ["build", str(PARAMS), "--output-dir"]
+    for index in range(rounds):
+        if peer_python is not None:
+            times["peer"].append(_peer(peer_python))
         _empty_cache()
-        _cadgen("build", str(PARAMS), "--output-dir", str(root))
-    for _ in range(repeat):
-        args = ["build", str(PARAMS), "--output-dir", str(root)]
-        if effects:
-            args += ["--effects", effects]
-        if cache == "cold":
-            _empty_cache()
-        runs.append(_cadgen(*args))
-    report = json.loads((root / "xin2024-planter" / "report.json").read_text())
-    return {"best": min(runs), "median": statistics.median(runs), "runs": runs,
-            "stages": {s["stage"]: s["seconds"] for s in report["stages"]}}
+        times["cold"].append(_cadgen(*args, str(root / "cold")))
+        stages["cold"] = _stages(root / "cold")
+        times["warm"].append(_cadgen(*args, str(root / "warm")))
+        stages["warm"] = _stages(root / "warm")
+        times["metrics"].append(_cadgen(*args, str(root / "metrics"), "--effects", "metrics"))
+        print(f"round {index + 1}/{rounds}: " + ", ".join(
+            f"{scene} {runs[-1]:.2f} s" for scene, runs in times.items() if runs), flush=True)
+    times["stages"] = stages
+    return times
+
+
+def _spread(runs) -> str:
+    return f"{min(runs):.2f}-{max(runs):.2f}"
 
 
 def sweep_table() -> list:
@@ -131,45 +164,68 @@ def batch_table(root: Path) -> list:
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", type=Path, default=REPO / "docs" / "performance.md")
-    parser.add_argument("--quick", action="store_true", help="one run of each build, no batch")
+    parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds (default 5)")
+    parser.add_argument("--quick", action="store_true", help="one round, no sweep table, no batch")
+    parser.add_argument("--no-peer", action="store_true",
+                        help="skip ncgears (it needs PyPI once, for its virtualenv)")
     args = parser.parse_args(argv)
+    # A user's first run writes the bytecode of our modules (pip compiled the peer's at its
+    # install); where PYTHONDONTWRITEBYTECODE is set, every run would compile ~200 modules
+    # again (0.1-0.3 s), so compile them once here, as the first run would.
+    import compileall
+
+    for package in ("cadgen", "kinematics"):
+        compileall.compile_dir(REPO / package, quiet=1)
+    peer_python = None
+    if not args.no_peer:
+        from .peer_ncgears import ensure_venv
+
+        peer_python = ensure_venv()
     with tempfile.TemporaryDirectory() as folder:
         root = Path(folder)
         _CACHE["directory"] = root / "gear-cache"
-        full = build_times(root / "full", 1 if args.quick else 3)
-        print(f"full build: best {full['best']:.2f} s, median {full['median']:.2f} s", flush=True)
-        warm = build_times(root / "warm", 1 if args.quick else 3, cache="warm")
-        print(f"full build, warm gear cache: best {warm['best']:.2f} s, median "
-              f"{warm['median']:.2f} s", flush=True)
-        metrics = build_times(root / "metrics", 1 if args.quick else 5, effects="metrics")
-        print(f"metrics only: best {metrics['best']:.2f} s, median {metrics['median']:.2f} s",
-              flush=True)
-        sweeps = sweep_table()
+        times = interleaved_rounds(root, 1 if args.quick else args.rounds, peer_python)
+        sweeps = [] if args.quick else sweep_table()
         batch = [] if args.quick else batch_table(root)
+    stages = times.pop("stages")
+    medians = {scene: statistics.median(runs) for scene, runs in times.items() if runs}
+    peer = medians.get("peer")
     cores = os.cpu_count()
     lines = ["# Performance", "",
              "Generated by `python -m benchmarks.performance` (do not edit by hand) on a "
-             f"{cores}-core machine. Whole-process wall times: `cadgen build` in a fresh "
+             f"{cores}-core machine. Whole-process wall times, each command in a fresh "
              "interpreter, imports included.", "",
-             "## Build of the paper's planting design", "",
-             "| scene | aim | best (s) | median (s) | runs |", "|---|---:|---:|---:|---:|",
-             f"| every effect (default scene), gear cache cold | 3 s | {full['best']:.2f} | "
-             f"{full['median']:.2f} | {len(full['runs'])} |",
-             f"| every effect, gear cache warm | | {warm['best']:.2f} | {warm['median']:.2f} | "
-             f"{len(warm['runs'])} |",
-             f"| metrics only (`--effects metrics`) | 0.5 s | {metrics['best']:.2f} | "
-             f"{metrics['median']:.2f} | {len(metrics['runs'])} |", "",
-             "Stages of the full build (last run, seconds; the rest of the wall time is "
-             "interpreter start, imports and writing the files), cold and warm gear cache:", "",
-             "| stage | cold (s) | warm (s) |", "|---|---:|---:|"]
-    lines += [f"| {stage} | {seconds:.3f} | {warm['stages'].get(stage, float('nan')):.3f} |"
-              for stage, seconds in full["stages"].items()]
-    lines += ["", "## Certified sweep against a plain scan", "",
-              "The build's own scenes and bounds; reference: the certified sweep at atol "
-              "1e-10 mm. The arm distance repeats every half turn, which the certified sweep "
-              "uses and a plain scan of a turn does not.", "",
-              "| clearance | method | minimum (mm) | error (mm) | poses | time (s) | "
-              "time vs certified |", "|---|---|---:|---:|---:|---:|---:|"]
+             "## Build of the paper's planting design against the peer", "",
+             f"{len(times['cold'])} rounds, interleaved: in each round the peer, then the cold "
+             "build, the warm build and the metrics-only build. The peer is ncgears 0.3.1 "
+             "generating and verifying ONE 24-tooth pair from its command line "
+             "(`python -m ncgears --centrode \"30 + 8*cos(phi)\" --teeth 24 --module 2.5`); "
+             "our build cuts, checks and meshes five pairs and does everything else. "
+             "Issue 15's aims: cold full build <= 0.35 x the peer, metrics only <= 0.05 x.", "",
+             "| command | median (s) | spread (s) | x peer (medians) | aim |",
+             "|---|---:|---:|---:|---:|"]
+    labels = {"peer": ("ncgears 0.3.1, one pair (the peer)", ""),
+              "cold": ("`cadgen build`, every effect, gear cache cold", "0.35"),
+              "warm": ("`cadgen build`, every effect, gear cache warm", ""),
+              "metrics": ("`cadgen build --effects metrics`", "0.05")}
+    for scene, runs in times.items():
+        if not runs:
+            continue
+        ratio = f"{medians[scene] / peer:.3f}" if peer else "n/a"
+        label, aim = labels[scene]
+        lines.append(f"| {label} | {medians[scene]:.2f} | {_spread(runs)} | {ratio} | {aim} |")
+    lines += ["", "Stages of the last cold and warm full builds (seconds; the rest of the wall "
+              "time is interpreter start, imports and writing the files):", "",
+              "| stage | cold (s) | warm (s) |", "|---|---:|---:|"]
+    lines += [f"| {stage} | {seconds:.3f} | {stages['warm'].get(stage, float('nan')):.3f} |"
+              for stage, seconds in stages["cold"].items()]
+    if sweeps:
+        lines += ["", "## Certified sweep against a plain scan", "",
+                  "The build's own scenes and bounds; reference: the certified sweep at atol "
+                  "1e-10 mm. The arm distance repeats every half turn, which the certified "
+                  "sweep uses and a plain scan of a turn does not.", "",
+                  "| clearance | method | minimum (mm) | error (mm) | poses | time (s) | "
+                  "time vs certified |", "|---|---|---:|---:|---:|---:|---:|"]
     for index, (label, method, value, error, poses, seconds) in enumerate(sweeps):
         base = sweeps[index - index % 2][5]
         lines.append(f"| {label} | {method} | {value:.9f} | {error:.1e} | {poses} | "

@@ -1,6 +1,6 @@
 """``python -m cadgen``: the same command line as the ``cadgen`` script."""
 
-from cadgen.cli import main
+from cadgen.cli import entry
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    entry()

@@ -33,7 +33,7 @@ from .scalar import minimize_scalar
 
 from . import tolerances as tol
 
-__all__ = ["CertifiedMinimum", "certified_minimum", "Verdict"]
+__all__ = ["CertifiedMinimum", "certified_minimum", "Verdict", "lipschitz_bound", "chord_bound"]
 
 
 class Verdict:
@@ -97,6 +97,39 @@ class CertifiedMinimum:
         if self.bound > target or self.certified:
             return Verdict.PASS
         return Verdict.UNDECIDED
+
+
+def lipschitz_bound(f_left, f_right, width, lipschitz):
+    """Least value on ``[a, a + width]`` of any ``L``-Lipschitz ``f`` with ``f(a) >= f_left``
+    and ``f(a + width) >= f_right`` (arrays broadcast together).
+
+    ``(f_left + f_right - L h) / 2`` where the two cones ``f_left - L x`` and
+    ``f_right - L (h - x)`` cross inside the interval; otherwise the higher end
+    alone bounds it, ``max(f_left, f_right) - L h`` (an end known only by a
+    loose lower bound then costs nothing).
+    """
+    f_left, f_right = np.asarray(f_left, dtype=float), np.asarray(f_right, dtype=float)
+    reach = np.asarray(lipschitz, dtype=float) * width
+    with np.errstate(invalid="ignore"):
+        return np.where(np.abs(f_left - f_right) <= reach, 0.5 * (f_left + f_right - reach),
+                        np.maximum(f_left, f_right) - reach)
+
+
+def chord_bound(f_left, f_right, width, curvature):
+    """Least value on ``[a, a + width]`` of any ``f`` with ``f'' <= K`` and end values at least
+    ``f_left``, ``f_right``: the minimum of ``chord(x) - K (x - a)(b - x) / 2`` (arrays broadcast).
+
+    Tighter than ``min(f_left, f_right) - K h^2 / 8`` wherever the ends differ;
+    like it, it holds for a pointwise minimum of such functions (a distance),
+    and for lower bounds of the end values (it grows with both).
+    """
+    f_left, f_right = np.asarray(f_left, dtype=float), np.asarray(f_right, dtype=float)
+    sag = 0.5 * np.asarray(curvature, dtype=float) * np.asarray(width, dtype=float) ** 2
+    rise = f_right - f_left
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.clip(np.where(sag > 0.0, 0.5 - rise / (2.0 * sag), 0.0), 0.0, 1.0)
+    t = np.where(sag > 0.0, t, np.where(rise >= 0.0, 0.0, 1.0))
+    return f_left + rise * t - sag * t * (1.0 - t)
 
 
 def _interval_bounds(f_left, f_right, width, lipschitz, curvature, interval_bound=None,

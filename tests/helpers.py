@@ -1,4 +1,4 @@
-"""Small helpers shared by tests: edited copies of the reference parameter file."""
+"""Small helpers shared by tests: edited copies of the reference parameter file, an FCL model."""
 
 import re
 from pathlib import Path
@@ -34,3 +34,16 @@ def with_keys(text: str, table: str, **keys) -> str:
         if not count:
             body = f"{key} = {value}\n" + body
     return text[:start] + body + text[end:]
+
+
+def fcl_bvh(mesh):
+    """A python-fcl BVH model of a trimesh mesh (the scene builds its own; tests compare)."""
+    import fcl
+    import numpy as np
+
+    model = fcl.BVHModel()
+    model.beginModel(len(mesh.faces), len(mesh.vertices))
+    model.addSubModel(np.asarray(mesh.vertices, dtype=np.float64),
+                      np.asarray(mesh.faces, dtype=np.int32))
+    model.endModel()
+    return model

@@ -58,7 +58,48 @@ def test_cached_builds_write_the_bytes_an_uncached_build_writes(paper, uncached,
     for name, data in uncached.items():
         assert cold_files[name] == data, name
         assert warm_files[name] == data, name
-    assert GearCache(cache).stats()[0] == 5
+    # five stages, and the bytes of every gear file (one per gear and the train sheet)
+    dxf = [name for name in uncached if name.startswith("gears/")]
+    assert len(_stage_entries(cache)) == 5
+    assert GearCache(cache).stats()[0] == 5 + len(dxf)
+
+
+def _stage_entries(cache: Path) -> list:
+    """The cache's entries holding a cut stage (the others hold a written file's bytes)."""
+    store = GearCache(cache)
+    return [entry for entry in sorted(cache.glob("??/*.gear"))
+            if not isinstance(store.get(entry.stem), bytes)]
+
+
+def test_a_warm_build_writes_the_gear_files_without_making_them(paper, uncached, tmp_path,
+                                                                 monkeypatch):
+    import cadgen.export.train_sheet as train_sheet
+
+    cache = tmp_path / "cache"
+    _build(paper, tmp_path / "cold", cache)
+
+    def made(*args, **kwargs):
+        raise AssertionError("a warm build made a gear file")
+
+    monkeypatch.setattr(train_sheet, "gear_dxf_bytes", made)
+    monkeypatch.setattr(train_sheet, "_sheet_bytes", made)
+    _, files = _build(paper, tmp_path / "warm", cache)
+    assert files == uncached
+
+
+def test_a_damaged_file_entry_is_made_again(paper, uncached, tmp_path):
+    cache = tmp_path / "cache"
+    _build(paper, tmp_path / "cold", cache)
+    store = GearCache(cache)
+    files = [entry for entry in sorted(cache.glob("??/*.gear"))
+             if isinstance(store.get(entry.stem), bytes)]
+    assert len(files) == sum(name.startswith("gears/") for name in uncached)
+    for victim in files[:3]:
+        data = victim.read_bytes()
+        victim.write_bytes(data[:-1] + bytes([data[-1] ^ 0x01]))   # a payload byte flipped
+    _, again = _build(paper, tmp_path / "again", cache)
+    assert again == uncached
+    assert all(isinstance(GearCache(cache).get(v.stem), bytes) for v in files[:3])
 
 
 def _equal(a, b, path="stage"):
@@ -144,7 +185,7 @@ def test_a_key_changes_with_what_determines_the_stage():
 def test_a_bad_entry_is_a_miss_and_the_build_recomputes_it(paper, uncached, tmp_path, damage):
     cache = tmp_path / "cache"
     _build(paper, tmp_path / "cold", cache)
-    entries = sorted(cache.glob("??/*.gear"))
+    entries = _stage_entries(cache)
     assert len(entries) == 5
     victim = entries[0]
     data = victim.read_bytes()

@@ -25,8 +25,9 @@ from cadgen.export.train_sheet import write_train_sheet  # noqa: E402
 from cadgen.gears.pairs import circle_pair, generate_pair  # noqa: E402
 from cadgen.gears.teeth import GearProfile, ToothSystem  # noqa: E402
 from cadgen.gears.trains import GearStage, GearTrain  # noqa: E402
-from cadgen.machine.hubs import (MIN_RIM_MODULES, WARN_RIM_MODULES, best_keyway_angle,  # noqa: E402
-                                 hub_hole, hub_train, rim_check, rim_thickness)
+from cadgen.machine.hubs import (KEYWAY_TIE_TOLERANCE, MIN_RIM_MODULES,  # noqa: E402
+                                 WARN_RIM_MODULES, best_keyway_angle, hub_hole, hub_train,
+                                 rim_check, rim_thickness)
 from cadgen.machine.model import Drivetrain, GearMount, KeySize, Shaft  # noqa: E402
 from cadgen.solids.extrude import to_trimesh  # noqa: E402
 from cadgen.solids.parts import gear_solid  # noqa: E402
@@ -221,6 +222,68 @@ def test_a_d_flat_faces_the_nearest_root():
     # the flat leaves more rim than the round part would there: it goes where the rim is least
     best = best_keyway_angle(eccentric_outline(), lambda a: hub_hole(12.0, flat_depth=1.0, angle=a))
     assert abs(np.angle(np.exp(1j * (best - np.pi)))) < np.radians(6)
+
+
+def _rim_by_direction(outline, hole_fn, steps=720):
+    """The radial rim of every scanned direction, as the full (direction x bin) table: the
+    hole's radial profile turned bin by bin against the outline's (the scan's definition)."""
+    from cadgen.machine.hubs import _polar_bins, _resampled
+
+    hole = np.asarray(hole_fn(0.0))
+    outer_bin, outer_radius = _polar_bins(_resampled(np.asarray(outline), steps * 8), steps)
+    inner_bin, inner_radius = _polar_bins(_resampled(hole, steps * 8), steps)
+    outer = np.full(steps, np.inf)
+    np.minimum.at(outer, outer_bin, outer_radius)
+    inner = np.zeros(steps)
+    np.maximum.at(inner, inner_bin, inner_radius)
+    circle = np.median(np.hypot(*hole.T))
+    beyond = inner > circle * (1 + 1e-9)
+    rim = np.empty(steps)
+    for k in range(steps):          # turned by k bins: bin b of the hole lands on b + k
+        landed = (np.arange(steps) + k) % steps
+        rim[k] = np.min(np.where(beyond, outer[landed] - inner, np.inf))
+    return rim
+
+
+@settings(max_examples=20, deadline=None, derandomize=True, database=None)
+@given(offset=st.floats(0.0, 8.0), teeth=st.integers(8, 60), diameter=st.floats(10.0, 24.0))
+def test_best_keyway_angle_is_the_first_best_of_every_direction(offset, teeth, diameter):
+    outline = eccentric_outline(offset=offset, teeth=teeth)
+    def hole(a):
+        return hub_hole(diameter, key=key_for(diameter), angle=a)
+    rim = _rim_by_direction(outline, hole)
+    chosen = best_keyway_angle(outline, hole)
+    index = int(round(chosen / (2 * np.pi / 720)))
+    assert rim[index] >= rim.max() - KEYWAY_TIE_TOLERANCE
+    assert not (rim[:index] >= rim.max() - KEYWAY_TIE_TOLERANCE).any()
+
+
+def test_a_circular_gears_keyway_takes_the_first_of_its_equal_directions(pair):
+    # z teeth: z directions leave the same rim but for rounding; the first one is taken
+    for profile in pair.profiles:
+        def hole(a):
+            return hub_hole(20.0, key=KEY_20, angle=a)
+        chosen = best_keyway_angle(profile.outline, hole)
+        assert chosen < 2 * np.pi / profile.teeth + 2 * np.pi / 720
+        rims = [rim_thickness(profile.outline, hole(chosen + 2 * np.pi * k / profile.teeth))[0]
+                for k in range(profile.teeth)]
+        assert np.ptp(rims) < 1e-6
+
+
+def test_the_cutting_outline_is_thinned_once_as_the_contour_thins_it(holed):
+    from cadgen.geometry.contour import thin_ring, thinned_contour
+    from cadgen.machine.hubs import cutting_outline
+
+    cut = cutting_outline(holed, 0.005)
+    expected = thinned_contour(holed.outline, 0.005, centre=holed.centre,
+                               bore_radius=holed.hole_reach)
+    np.testing.assert_array_equal(cut.outline, expected)
+    np.testing.assert_array_equal(cut.pitch, thin_ring(holed.pitch_curve, 0.005)[0])
+    assert cut.tolerance_used == 0.005 and not cut.outline.flags.writeable
+    assert cutting_outline(holed, 0.005) is cut                # remembered on the profile
+    assert cutting_outline(holed, 0.002) is not cut            # per tolerance
+    turned = dataclasses.replace(holed, hole=holed.hole.copy())
+    assert cutting_outline(turned, 0.005) is not cut           # a changed profile: again
 
 
 def test_rim_check_levels(pair):

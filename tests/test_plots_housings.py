@@ -62,6 +62,20 @@ def test_png_valid_and_deterministic(housing):
     assert housing_figure(case, built) == first
 
 
+def test_texts_inside_the_figure_and_apart(housing, monkeypatch):
+    """Seat labels, dimensions, tick labels, titles and the legend: none clipped, none on
+    another (the section's and the plan's labels measured after the draw)."""
+    import cadgen.report.plots.housings as module
+    from test_plots_layout import assert_texts_clear
+
+    drawn = []
+    real = module._png
+    monkeypatch.setattr(module, "_png", lambda figure: (drawn.append(figure), real(figure))[1])
+    case, built = housing
+    housing_figure(case, built)
+    assert_texts_clear(drawn[0], case)
+
+
 def test_plan_draws_every_bolt_hole_and_seat(housing):
     case, built = housing
     figure, ax = _figure()
@@ -75,9 +89,12 @@ def test_plan_draws_every_bolt_hole_and_seat(housing):
     assert len(drawn["through_holes"]) == sum(seat.through for seat in built.seats)
     assert {text.get_text() for text in drawn["labels"]} >= {
         f"{seat.shaft} 6001" for seat in built.seats}
-    import matplotlib.pyplot as plt
-
-    plt.close(figure)
+    # the holes' extents given, not walked: the drawing's limits hold every bolt hole
+    (x0, y0), (x1, y1) = ax.dataLim.get_points()
+    holes = np.asarray(built.bolt_positions)
+    radius = built.bolt_hole_diameter / 2
+    assert x0 <= holes[:, 0].min() - radius and holes[:, 0].max() + radius <= x1
+    assert y0 <= holes[:, 1].min() - radius and holes[:, 1].max() + radius <= y1
 
 
 def test_section_follows_the_seat_line():
@@ -102,8 +119,15 @@ def test_jobs_skip_housings_without_seats():
     assert list(jobs) == ["housing-box.png"]
 
 
-def test_build_has_a_figure_per_gearbox(planting_solids):
+def test_build_has_a_figure_per_gearbox(planting_solids, monkeypatch):
+    import cadgen.report.plots.housings as module
+    from test_plots_layout import assert_texts_clear
+
+    drawn = []
+    real = module._png
+    monkeypatch.setattr(module, "_png", lambda figure: (drawn.append(figure), real(figure))[1])
     housings = planting_solids[6]
     jobs = housing_figure_jobs({"gearbox1": housings[0], "gearbox2": housings[1]})
     assert {"housing-gearbox1.png", "housing-gearbox2.png"} <= set(jobs)
     assert jobs["housing-gearbox1.png"]()[:8] == PNG_SIGNATURE
+    assert_texts_clear(drawn[0], "gearbox1")    # the long one: its plan over its section

@@ -253,3 +253,25 @@ def test_a_batch_tells_each_design_as_it_starts(tmp_path):
                for line in lines)
     assert lines[-1].startswith(f"[{len(jobs)}/{len(jobs)}] ")
     assert lines[-1].endswith("; 0 running, 0 queued")
+
+
+@pytest.mark.skipif(not cadgen.pipeline.figures._can_fork(), reason="needs fork and 2 cores")
+def test_figures_without_gears_are_drawn_beside_and_counted_there(params, tmp_path):
+    result, events = run_with_events(params, SIDE_BY_SIDE + ["plots"], tmp_path)
+    figures = sorted(f.removeprefix("plots/") for f in result.files if f.startswith("plots/"))
+    here = [e for e in events if e.stage == "plots" and not e.beside]
+    there = [e for e in events if e.stage == "plots" and e.beside]
+    for events_of_one_process in (here, there):
+        states = [e.state for e in events_of_one_process]
+        assert states[0] == "started" and states[-1] == "finished"
+        steps = [e for e in events_of_one_process if e.state == "step"]
+        assert [e.step for e in steps] == list(range(1, len(steps) + 1))
+    drawn_here = {e.detail for e in here if e.state == "step"}
+    drawn_there = {e.detail for e in there if e.state == "step"}
+    # each figure drawn once, the gears' in this process (they are cut after the fork)
+    assert sorted(drawn_here | drawn_there) == figures and not drawn_here & drawn_there
+    assert drawn_here == {f for f in figures if f.startswith("gears-") or f == "assembly.png"}
+    record = next(r for r in result.report["stages"] if r["stage"] == "plots")
+    assert record["message"].startswith(f"{len(drawn_there)} of {len(figures)} figures drawn "
+                                        "beside the teeth, in a second process (")
+    assert {e.steps for e in here if e.state == "step"} == {len(drawn_here)}

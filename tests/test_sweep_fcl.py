@@ -53,14 +53,9 @@ def face_box(x_face, depth=50.0, half_y=60.0, half_z=20.0):
 # ------------------------------------------------------------------ python-fcl itself
 def _bvh(manifold):
     from cadgen.solids.extrude import to_trimesh
+    from helpers import fcl_bvh
 
-    mesh = to_trimesh(manifold, "probe")
-    model = fcl.BVHModel()
-    model.beginModel(len(mesh.faces), len(mesh.vertices))
-    model.addSubModel(np.asarray(mesh.vertices, dtype=np.float64),
-                      np.asarray(mesh.faces, dtype=np.int32))
-    model.endModel()
-    return model
+    return fcl_bvh(to_trimesh(manifold, "probe"))
 
 
 def test_python_fcl_behaviour_the_scene_relies_on():
@@ -151,7 +146,9 @@ def test_a_solid_wholly_inside_another_interferes():
     x_face = 60.0
     assembly, scene = carrier_scene(*face_box(x_face, depth=500.0, half_y=300.0, half_z=50.0))
     pose = instance_pose(assembly, "moving", 0.0)
-    moving, fixed = scene._instances["moving"][4], scene._instances["fixed"][4]
+    moving = fcl.CollisionObject(_bvh(assembly.parts[0].solid),
+                                 fcl.Transform(pose[:3, :3].copy(), pose[:3, 3].copy()))
+    fixed = fcl.CollisionObject(_bvh(assembly.parts[1].solid), fcl.Transform())
     proximity = scene.distance(0.0)
     assert fcl.collide(moving, fixed, fcl.CollisionRequest(), fcl.CollisionResult()) == 0
     assert proximity.overlap and proximity.distance == 0.0
@@ -292,3 +289,149 @@ def test_housing_ground_clearance_agrees_with_the_envelope_circles(planting):
     assert result.bound >= low - result.atol
     assert result.pair[1] == "ground"
     assert result.point_b[1] == pytest.approx(evaluation.events.soil_level)
+
+
+# ------------------------------------------------------------------ the engine against brute force
+def _brute_distance(assembly, group_a, group_b, phi, models={}):
+    """Least FCL distance over every pair, fresh objects (0 when a pair collides): the
+    exhaustive peer of the scene's pruned evaluation."""
+    best = math.inf
+    parts = {part.name: part for part in assembly.parts}
+    for a in group_a:
+        for b in group_b:
+            objects = []
+            for name in (a, b):
+                part = parts.get(name) or parts[name.rsplit("-arm", 1)[0]]
+                if part.name not in models:
+                    models[part.name] = _bvh(part.solid)
+                pose = instance_pose(assembly, name, phi)
+                objects.append(fcl.CollisionObject(models[part.name],
+                                                   fcl.Transform(pose[:3, :3].copy(),
+                                                                 pose[:3, 3].copy())))
+            if fcl.collide(*objects, fcl.CollisionRequest(), fcl.CollisionResult()):
+                return 0.0
+            best = min(best, fcl.distance(*objects, fcl.DistanceRequest(), fcl.DistanceResult()))
+    return best
+
+
+def _arm_groups(assembly):
+    from cadgen.pipeline.clearances import ARM_PARTS as ALL_ARM_PARTS, _present
+
+    present = _present(ALL_ARM_PARTS, {part.name: part for part in assembly.parts})
+    return [f"{n}-arm1" for n in present], [f"{n}-arm2" for n in present]
+
+
+def test_scene_distance_is_the_least_of_every_pair_by_brute_force(planting):
+    # the scene skips pairs by bounds and hulls: at random poses it must agree with the
+    # exhaustive FCL minimum (arms: every part of both arms, blades included; housings: ground)
+    _, _, _, assembly, _ = planting
+    rng = np.random.default_rng(20261121)
+    for group_a, group_b in (_arm_groups(assembly), (HOUSINGS, ("ground",))):
+        scene = FclScene(assembly, group_a, group_b)
+        for phi in rng.uniform(0.0, 2 * math.pi, 12):
+            near = scene.distance(phi)
+            truth = _brute_distance(assembly, group_a, group_b, phi)
+            assert near.distance == pytest.approx(truth, abs=1e-9)
+            assert np.linalg.norm(near.point_b - near.point_a) == pytest.approx(truth, abs=1e-9)
+
+
+def _stage_inputs(planting):
+    from types import SimpleNamespace
+
+    from cadgen.cam.design import design_cam
+
+    params, mechanism, evaluation, assembly, _ = planting
+    cam = design_cam(params, mechanism, evaluation.events)
+    return params, mechanism, evaluation, SimpleNamespace(assembly=assembly), cam
+
+
+def test_arm_clearance_with_per_part_bounds_is_confirmed_by_dense_scans(planting):
+    from cadgen.pipeline.clearances import arm_interference
+
+    params, mechanism, evaluation, solids, cam = _stage_inputs(planting)
+    section = arm_interference(params, mechanism, solids, cam)
+    minimum, bound = section["minimum_mm"], section["certified_bound_mm"]
+    assert section["certified"] and section["verdict"] == "pass"
+    assert minimum - bound <= params.resolution.sweep_atol * (1 + 1e-9)
+    # dense scans off the certified grid, through a scene of its own
+    scene = FclScene(solids.assembly, *_arm_groups(solids.assembly))
+    coarse = np.linspace(0.0, math.pi, 720, endpoint=False) + math.pi / 1440 * 0.37
+    values = scene.distances(coarse)
+    where = math.radians(section["carrier_angle_deg"])
+    window = np.linspace(where - 1e-3, where + 1e-3, 201)
+    dense = min(values.min(), scene.distances(window).min())
+    assert bound <= dense + 1e-12
+    assert minimum <= dense + 1e-9
+    # the window's spacing leaves at most K h^2 / 8 between its best sample and the bottom
+    from cadgen.pipeline.clearances import _arm_bounds
+
+    speed, acceleration = _arm_bounds(mechanism, {p.name: p for p in solids.assembly.parts}, cam)
+    curvature = 2 * acceleration + (2 * speed) ** 2 / bound
+    assert dense - minimum <= curvature * (window[1] - window[0]) ** 2 / 8
+    assert _brute_distance(solids.assembly, *_arm_groups(solids.assembly), where) \
+        == pytest.approx(minimum, abs=1e-9)
+
+
+def test_ground_clearance_with_per_part_bounds_matches_the_one_bound_sweep(planting):
+    from cadgen.pipeline.clearances import ground_clearance
+
+    params, mechanism, evaluation, solids, _ = _stage_inputs(planting)
+    section = ground_clearance(params, mechanism, solids, evaluation)
+    parts = {part.name: part for part in solids.assembly.parts}
+    rc = mechanism.carrier_radii["C"]
+    speed = max(max(part_reach(parts[f"gearbox1-{n}"], axis=Z) for n in ("base", "cover")),
+                rc + max(part_reach(parts[f"gearbox2-{n}"], axis=Z) for n in ("base", "cover")))
+    one = certified_distance(FclScene(solids.assembly, HOUSINGS, ["ground"]), lipschitz=speed,
+                             acceleration=speed, steps=90, atol=params.resolution.sweep_atol)
+    atol = params.resolution.sweep_atol
+    assert section["certified"] and one.certified
+    # both certified: each minimum within atol above the true one, each bound below it
+    assert section["minimum_mm"] == pytest.approx(one.minimum, abs=atol)
+    assert section["certified_bound_mm"] <= one.minimum + 1e-12
+    assert one.bound <= section["minimum_mm"] + 1e-12
+    # the lowest housing corner over the soil: a plane distance, by hand at the argument
+    where = math.radians(section["carrier_angle_deg"])
+    # the slab's top as meshed: manifold3d's turn of the extrusion leaves it 1e-9 mm off
+    soil = float(parts["ground"].mesh.vertices[:, 1].max())
+    assert soil == pytest.approx(evaluation.events.soil_level, abs=1e-8)
+    lowest = min(float((part.mesh.vertices @ instance_pose(solids.assembly, name, where)[:3, :3].T
+                        + instance_pose(solids.assembly, name, where)[:3, 3])[:, 1].min())
+                 for name in HOUSINGS
+                 for part in [parts[name.rsplit("-arm", 1)[0]]])
+    assert section["minimum_mm"] == pytest.approx(lowest - soil, abs=1e-9)
+
+
+def test_per_instance_bounds_are_checked():
+    assembly, scene = carrier_scene(*face_box(130.0))
+    with pytest.raises(ValueError, match="no speed bound"):
+        certified_distance(scene, instance_bounds={"moving": (RHO, RHO)})
+    with pytest.raises(ValueError, match="finite >= 0"):
+        certified_distance(scene, instance_bounds={"moving": (-1.0, RHO), "fixed": (0.0, 0.0)})
+    with pytest.raises(ValueError, match="speed bound is needed"):
+        certified_distance(scene)
+    # the sum of the two instances' bounds is the pair's: the same certified minimum
+    both = certified_distance(scene, instance_bounds={"moving": (RHO, RHO), "fixed": (0.0, 0.0)},
+                              steps=360, atol=1e-9)
+    assert both.certified and both.minimum == pytest.approx(130.0 - RHO, abs=1e-9)
+
+
+def test_every_interval_of_the_arm_certificate_holds_its_bound(planting):
+    # the pairwise search proves a lower bound on each interval of a partition of [0, pi]:
+    # the distance sampled inside each (quarter points, through a scene of its own) is above it
+    from cadgen.pipeline.clearances import _arm_part_bounds
+
+    params, mechanism, evaluation, solids, cam = _stage_inputs(planting)
+    assembly = solids.assembly
+    group_a, group_b = _arm_groups(assembly)
+    bounds = _arm_part_bounds(mechanism, {part.name: part for part in assembly.parts}, cam)
+    instance = {name: bounds[name.rsplit("-arm", 1)[0]] for name in group_a + group_b}
+    result = certified_distance(FclScene(assembly, group_a, group_b), steps=90, upper=math.pi,
+                                atol=1e-6, instance_bounds=instance)
+    certificate = result.certificate[np.argsort(result.certificate[:, 0])]
+    assert certificate[0, 0] == 0.0 and certificate[-1, 1] == math.pi
+    assert np.all(certificate[1:, 0] == certificate[:-1, 1])
+    assert result.certified and certificate[:, 2].min() == pytest.approx(result.bound, abs=0)
+    scene = FclScene(assembly, group_a, group_b)
+    inside = certificate[:, :1] + np.array([0.25, 0.5, 0.75]) * np.diff(certificate[:, :2])
+    distances = scene.distances(inside.ravel()).reshape(inside.shape)
+    assert np.all(certificate[:, 2:] <= distances + 1e-12)

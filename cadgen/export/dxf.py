@@ -27,6 +27,10 @@ The dense outline is thinned by Douglas-Peucker to a chord tolerance (halved unt
 stays simple and clear of the disc holding the bore and its keyway; the tolerance used is in :class:`DxfSummary`). Every
 document passes ``ezdxf``'s audit and is written atomically and byte-identically for the same
 input (fixed metadata). ``ezdxf`` and ``shapely`` are imported inside the functions.
+
+Written fast, to ezdxf's own bytes: a polyline's vertices are set in one go and written as one
+block of text (when that block is, in this process, what ezdxf writes vertex by vertex), the
+extents are read off the vertex arrays, and a good ring is checked without sorting its points.
 """
 
 from __future__ import annotations
@@ -55,6 +59,8 @@ __all__ = [
     "CONSTRUCTION_LAYERS",
     "write_gear_dxf",
     "write_cam_dxf",
+    "gear_dxf_bytes",
+    "writer_fingerprint",
 ]
 
 PITCH_LAYER, CENTRE_LAYER, LABEL_LAYER = "CONSTRUCTION-PITCH", "CONSTRUCTION-CENTRE", "CONSTRUCTION-LABELS"
@@ -163,9 +169,9 @@ def _plate_problems(outline, pitch_curve, centre, bore, label: str, hole=None) -
 
     problems = []
     outline = closed_points(outline)
-    outline_problems = ring_problems(f"{label}: outline", outline)
+    outline_problems = _ring_problems(f"{label}: outline", outline)
     problems += outline_problems
-    problems += ring_problems(f"{label}: pitch_curve", closed_points(pitch_curve))
+    problems += _ring_problems(f"{label}: pitch_curve", closed_points(pitch_curve))
     given_centre = centre
     centre = np.asarray(centre, dtype=float)
     if centre.shape != (2,) or not np.isfinite(centre).all():
@@ -190,7 +196,7 @@ def _hole_problems(outline, hole, label: str, outline_problems) -> list[str]:
     import shapely
 
     hole = closed_points(hole)
-    problems = ring_problems(f"{label}: hole", hole)
+    problems = _ring_problems(f"{label}: hole", hole)
     if problems or outline_problems:
         return problems
     ring, inner = shapely.LinearRing(outline), shapely.LinearRing(hole)
@@ -200,6 +206,23 @@ def _hole_problems(outline, hole, label: str, outline_problems) -> list[str]:
                         f"origin) is not inside the outline (nearest outline point "
                         f"{clearance:.6g} mm from it)")
     return problems
+
+
+def _ring_problems(label: str, points: np.ndarray) -> list[str]:
+    """:func:`cadgen.geometry.contour.ring_problems`, answered at once for a good ring.
+
+    A finite (n, 2) ring whose polygon is simple and encloses area has at least three
+    distinct points, so it has none of the problems; only a ring failing that is looked at
+    in full, for the messages (whose distinct-points count sorts every point).
+    """
+    import shapely
+
+    if (points.ndim == 2 and points.shape[1] == 2 and len(points) >= 3
+            and np.isfinite(points).all()):
+        ring = shapely.LinearRing(points)
+        if ring.is_simple and shapely.Polygon(ring).area > 0.0:
+            return []
+    return ring_problems(label, points)
 
 
 def _finite(value, shape: tuple) -> bool:
@@ -267,16 +290,95 @@ def _add_centre_mark(msp, centre, half: float) -> None:
     msp.add_line((cx, cy - half), (cx, cy + half), dxfattribs={"layer": CENTRE_LAYER})
 
 
+def _add_polyline(msp, points, *, close: bool, layer: str, fast: bool | None = None):
+    """An LWPOLYLINE through ``points`` ((n, 2) float), its vertices set in one go.
+
+    ``add_lwpolyline`` appends vertex by vertex, copying the whole vertex array each time
+    (quadratic: a third of a gear file's writing time); the entity stores each vertex as
+    (x, y, start width, end width, bulge), which is what is set here, zeros but x and y.
+    Its vertices are then written as one block of text (:func:`_vertex_block_class`) when
+    ``fast`` (default: when this process's ezdxf writes that block byte for byte as it
+    writes vertex by vertex, :func:`_fast_vertices`). ``tests/test_dxf_speed.py`` checks
+    the bytes are those ``add_lwpolyline`` gives.
+    """
+    points = np.asarray(points, dtype=float)
+    polyline = msp.add_lwpolyline([], format="xy", close=close, dxfattribs={"layer": layer})
+    vertices = np.zeros((len(points), 5))
+    vertices[:, :2] = points
+    if _fast_vertices() if fast is None else fast:
+        polyline.lwpoints = _vertex_block_class()()
+    polyline.lwpoints.set(vertices)
+    return polyline
+
+
+_FAST: list = []
+
+
+def _vertex_block_class():
+    """ezdxf's LWPOLYLINE vertex array, written as one block of text.
+
+    ezdxf writes each vertex as its own tag objects (an x and a y tag, each formatted on its
+    own: half a gear file's writing time); these vertices (no widths, no bulges) are the
+    same ``"%3d\\n%s\\n"`` lines, formatted in one pass. Anything else (a width or a bulge)
+    is written by ezdxf's own code.
+    """
+    if len(_FAST) < 2:
+        from ezdxf.entities.lwpolyline import LWPolylinePoints
+
+        class _Block:      # what a text tag writer asks of a tag
+            __slots__ = ("text",)
+            code = LWPolylinePoints.VERTEX_CODE
+
+            def __init__(self, text: str):
+                self.text = text
+
+            def dxfstr(self) -> str:
+                return self.text
+
+        class VertexBlock(LWPolylinePoints):
+            __slots__ = ()
+
+            def dxftags(self):
+                if self.values[:, 2:].any():
+                    yield from super().dxftags()
+                    return
+                x, y = self.VERTEX_CODE, self.VERTEX_CODE + 10
+                yield _Block("".join([f"{x:3d}\n{a!r}\n{y:3d}\n{b!r}\n"
+                                      for a, b in self.values[:, :2].tolist()]))
+
+        _FAST.append(VertexBlock)
+        _FAST.append(None)
+    return _FAST[0]
+
+
+def _fast_vertices() -> bool:
+    """Whether :func:`_vertex_block_class` writes what ezdxf writes, in this process: a probe
+    polyline (awkward numbers among its coordinates) written both ways, compared byte for
+    byte, once."""
+    _vertex_block_class()
+    if _FAST[1] is None:
+        probe = np.array([[0.0, -0.0], [1e-300, -1.5e300], [123456789.123456789, 1 / 3],
+                          [-2.5, 1e16], [0.1 + 0.2, 5e-324]])
+        texts = []
+        for fast in (False, True):
+            doc = _new_document()
+            _add_polyline(doc.modelspace(), probe, close=True, layer="OUTLINE", fast=fast)
+            stream = io.StringIO()
+            with _fixed_metadata():
+                doc.write(stream)
+            texts.append(stream.getvalue())
+        _FAST[1] = texts[0] == texts[1]
+    return _FAST[1]
+
+
 def _add_gear(msp, outline: np.ndarray, pitch: np.ndarray, centre: np.ndarray, bore_radius: float,
               module: float, hole=None) -> None:
     """Add one placed gear's entities (already in sheet coordinates) to the modelspace; its
     ``hole`` (placed likewise) is drawn in place of the bore circle."""
-    msp.add_lwpolyline(outline.tolist(), format="xy", close=True, dxfattribs={"layer": "OUTLINE"})
-    msp.add_lwpolyline(open_ring(pitch, PITCH_CURVE_GAP).tolist(), format="xy", close=False,
-                       dxfattribs={"layer": PITCH_LAYER})
+    _add_polyline(msp, outline, close=True, layer="OUTLINE")
+    _add_polyline(msp, open_ring(pitch, PITCH_CURVE_GAP), close=False, layer=PITCH_LAYER)
     if hole is not None:
-        msp.add_lwpolyline(closed_points(hole).tolist(), format="xy", close=True,
-                           dxfattribs={"layer": "BORE"})
+        _add_polyline(msp, closed_points(hole), close=True, layer="BORE")
     elif bore_radius > 0:
         msp.add_circle(centre.tolist(), bore_radius, dxfattribs={"layer": "BORE"})
     _add_centre_mark(msp, centre, CENTRE_MARK_HALF_LENGTH_MODULES * module)
@@ -301,8 +403,16 @@ def _set_extents(doc) -> None:
     from ezdxf import bbox
 
     msp = doc.modelspace()
-    box = bbox.extents(entity for entity in msp if entity.dxftype() != "TEXT")
+    # a polyline without bulges spans its vertices: their least and greatest coordinates are
+    # what ezdxf's bounding box gives (a fifth of the writing time when it walks them)
+    polylines = [entity for entity in msp if entity.dxftype() == "LWPOLYLINE"
+                 and not entity.lwpoints.values[:, 4].any()]
+    spanned = {id(p) for p in polylines}
+    box = bbox.extents(entity for entity in msp if entity.dxftype() != "TEXT"
+                       and id(entity) not in spanned)
     corners = [np.array([box.extmin, box.extmax])[:, :2]] if box.has_data else []
+    corners += [np.array([p.lwpoints.values[:, :2].min(axis=0), p.lwpoints.values[:, :2].max(axis=0)])
+                for p in polylines if len(p.lwpoints)]
     corners += [_text_box(text.dxf.align_point, text.dxf.text, text.dxf.height)
                 for text in msp.query("TEXT")]
     if not corners:
@@ -343,6 +453,31 @@ def _thin_gear(profile, outline: np.ndarray, pitch: np.ndarray, tolerance: float
     thinned, used = thin_outline(outline, tolerance, profile.centre, _hole_reach(profile))
     thin_pitch, _ = thin_ring(pitch, tolerance)
     return thinned, used, thin_pitch
+
+
+_WRITER: list = []
+
+
+def writer_fingerprint() -> str:
+    """SHA-256 of what decides a written gear file's bytes besides its inputs: the sources of
+    the writers and of the thinning (this module, :mod:`cadgen.export.train_sheet`,
+    :mod:`cadgen.geometry.contour`, :mod:`cadgen.machine.hubs`) and ezdxf's version. Part of
+    the gear cache's key of a file (:func:`cadgen.gears.cache.file_key`): an edit is a new key."""
+    if not _WRITER:
+        import hashlib
+        from importlib.metadata import version
+
+        import cadgen.geometry.contour
+        import cadgen.machine.hubs
+
+        # the installed version, read without importing ezdxf: a warm build need not load it
+        digest = hashlib.sha256(f"ezdxf={version('ezdxf')}\0".encode())
+        here = Path(__file__).parent
+        for source in (Path(__file__), here / "train_sheet.py",
+                       Path(cadgen.geometry.contour.__file__), Path(cadgen.machine.hubs.__file__)):
+            digest.update(f"{source.name}\0".encode() + source.read_bytes() + b"\0")
+        _WRITER.append(digest.hexdigest())
+    return _WRITER[0]
 
 
 def _hole_reach(profile) -> float:
@@ -389,18 +524,31 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
     ``CONSTRUCTION-CENTRE`` (two LINEs crossing at the centre, two modules long).
     """
     tolerance = _check_tolerance(chord_tolerance)
-    problems = _gear_problems(profile)
-    if problems:
-        raise DxfInputError(f"cannot export gear {getattr(profile, 'name', '?')!r} to DXF", problems)
+    _raise_gear_problems(profile)
     path = Path(path)
     outline, used, pitch = _thin_gear(profile, closed_points(profile.outline),
                                       closed_points(profile.pitch_curve), tolerance)
+    write_bytes_atomic(path, gear_dxf_bytes(profile, outline, pitch, path=path))
+    area, perimeter = ring_measures(outline)
+    return DxfSummary(path, len(outline), used, area, perimeter)
+
+
+def gear_dxf_bytes(profile, outline: np.ndarray, pitch: np.ndarray, *, path="gear.dxf") -> bytes:
+    """The bytes of a gear's DXF file (as :func:`write_gear_dxf` writes it), for a profile
+    already checked (:func:`_raise_gear_problems`) and its outline and pitch curve already
+    thinned (:func:`cadgen.machine.hubs.cutting_outline`). ``path`` only names the file in an
+    audit failure."""
     doc = _new_document()
     _add_gear(doc.modelspace(), outline, pitch, np.asarray(profile.centre, dtype=float),
               float(profile.bore_radius), float(profile.module), getattr(profile, "hole", None))
-    write_bytes_atomic(path, _audited_bytes(doc, path))
-    area, perimeter = ring_measures(outline)
-    return DxfSummary(path, len(outline), used, area, perimeter)
+    return _audited_bytes(doc, Path(path))
+
+
+def _raise_gear_problems(profile) -> None:
+    """Raise :class:`DxfInputError` listing every problem of ``profile``; nothing if none."""
+    problems = _gear_problems(profile)
+    if problems:
+        raise DxfInputError(f"cannot export gear {getattr(profile, 'name', '?')!r} to DXF", problems)
 
 
 def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius: float = 0.0,

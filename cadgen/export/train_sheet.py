@@ -20,8 +20,8 @@ from cadgen.export.dxf import (CENTRE_MARK_HALF_LENGTH_MODULES, LABEL_GAP_MODULE
                                TEXT_WIDTH_PER_CHARACTER, VIEW_GAP_FRACTION, VIEW_GAP_MIN,
                                VIEW_SHIFT_STEP, DxfInputError, DxfSummary, _add_centre_mark,
                                _add_gear, _add_label, _audited_bytes, _check_tolerance, _finite,
-                               _gear_problems, _hole_reach, _new_document, _text_box, _thin_gear,
-                               write_gear_dxf)
+                               _gear_problems, _hole_reach, _new_document, _raise_gear_problems,
+                               _text_box, _thin_gear, gear_dxf_bytes, writer_fingerprint)
 from cadgen.geometry.contour import closed_points, ring_measures
 
 __all__ = ["write_train_sheet", "write_train_files"]
@@ -69,6 +69,24 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
     """
     tolerance = _check_tolerance(chord_tolerance)
     placements = list(placements)
+    planes = _checked_sheet(placements, label_height, planes)
+    thinned = {}  # the same profile placed twice is thinned once
+
+    def cut(profile):
+        if id(profile) not in thinned:
+            thinned[id(profile)] = _thin_gear(profile, closed_points(profile.outline),
+                                              closed_points(profile.pitch_curve), tolerance)
+        return thinned[id(profile)]
+
+    path = Path(path)
+    data, summaries = _sheet_bytes(path, placements, planes, float(label_height), cut)
+    write_bytes_atomic(path, data)
+    return summaries
+
+
+def _checked_sheet(placements, label_height, planes, *, profiles: bool = True) -> list:
+    """The plane of each placement; raise :class:`DxfInputError` listing every bad placement,
+    profile (unless ``profiles`` is False: checked already), plane or label height."""
     problems = []
     if not placements:
         problems.append("placements is empty: a sheet needs at least one gear")
@@ -88,24 +106,24 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
         name = getattr(profile, "name", None)
         if not isinstance(name, str) or not name.strip() or any(ord(ch) < 32 for ch in name):
             problems.append(f"{label}: name must be a non-empty single-line string, got {name!r}")
-        problems += _gear_problems(profile, label=label)
+        if profiles:
+            problems += _gear_problems(profile, label=label)
     if not problems:
         planes, plane_problems = _sheet_planes(placements, planes)
         problems += plane_problems
     if problems:
         raise DxfInputError("cannot export the train sheet to DXF", problems)
+    return planes
 
-    path = Path(path)
+
+def _sheet_bytes(path: Path, placements, planes, label_height: float, cut):
+    """The sheet's bytes and one :class:`DxfSummary` per placement, for checked placements;
+    ``cut(profile) -> (outline, tolerance used, pitch curve)`` thinned, in the body frame."""
     # a sheet for people, never cut: its gear names and view titles are printed
     doc = _new_document(printed=(LABEL_LAYER,))
     summaries, gears = [], []
-    thinned = {}  # the same profile placed twice is thinned once
     for (profile, angle, offset), plane in zip(placements, planes):
-        key = id(profile)
-        if key not in thinned:
-            thinned[key] = _thin_gear(profile, closed_points(profile.outline),
-                                      closed_points(profile.pitch_curve), tolerance)
-        outline, used, pitch = thinned[key]
+        outline, used, pitch = cut(profile)
         rotation = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
         centre = np.asarray(profile.centre, dtype=float)
         move = np.asarray(offset, dtype=float)
@@ -117,9 +135,8 @@ def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: f
                                  hole))
         area, perimeter = ring_measures(outline)
         summaries.append(DxfSummary(path, len(outline), used, area, perimeter))
-    _draw_views(doc.modelspace(), gears, float(label_height))
-    write_bytes_atomic(path, _audited_bytes(doc, path))
-    return tuple(summaries)
+    _draw_views(doc.modelspace(), gears, label_height)
+    return _audited_bytes(doc, path), tuple(summaries)
 
 
 @dataclass(frozen=True)
@@ -219,21 +236,78 @@ def _view_title(index: int, count: int, shift: float) -> str:
     return f"gear plane {index + 1} of {count}" + (f" (x + {shift:g} mm)" if shift else "")
 
 
-def write_train_files(train, folder, chord_tolerance: float) -> list:
+def write_train_files(train, folder, chord_tolerance: float, cache=None) -> list:
     """One DXF per gear and an assembled sheet of the train at the start position, one view
-    per gear plane (the gears linked by meshes; gears on one shaft are in different planes)."""
+    per gear plane (the gears linked by meshes; gears on one shaft are in different planes).
+
+    Each gear is checked once and thinned once (:func:`cadgen.machine.hubs.cutting_outline`,
+    shared with its solid): its file and the sheet draw that outline. With a gear ``cache``
+    (:class:`~cadgen.gears.cache.GearCache`; by default the one the train was cut with,
+    ``train.cache``) each file's bytes are looked up under the SHA-256 of everything that
+    decides them (:func:`cadgen.gears.cache.file_key`) and stored once made: a warm build
+    writes the same bytes without making them.
+    """
     from cadgen.gears.trains import _placements
 
-    written = []
-    for profile, _, _, _ in train.gears:
-        summary = write_gear_dxf(folder / f"{profile.file_stem}.dxf", profile,
-                                 chord_tolerance=chord_tolerance)
-        written.append(summary.path)
+    cache = cache if cache is not None else getattr(train, "cache", None)
+    tolerance = _check_tolerance(chord_tolerance)
+    folder = Path(folder)
+    profiles = [profile for profile, _, _, _ in train.gears]
     placements = _placements(train)
-    write_train_sheet(folder / "train.dxf", placements, chord_tolerance=chord_tolerance,
-                      planes=_mesh_planes(train, [profile.name for profile, _, _ in placements]))
-    written.append(folder / "train.dxf")
+    planes = _mesh_planes(train, [profile.name for profile, _, _ in placements])
+    files = _CachedFiles(cache, tolerance)
+    written = []
+    for profile in profiles:
+        path = folder / f"{profile.file_stem}.dxf"
+        write_bytes_atomic(path, files.get(("gear dxf", profile), lambda profile=profile, path=path:
+                                           gear_dxf_bytes(profile, *_cut(profile, tolerance)[::2],
+                                                          path=path)))
+        written.append(path)
+    sheet = folder / "train.dxf"
+
+    def make_sheet():
+        checked = _checked_sheet(placements, LABEL_HEIGHT, planes, profiles=False)
+        return _sheet_bytes(sheet, placements, checked, LABEL_HEIGHT,
+                            lambda profile: _cut(profile, tolerance))[0]
+
+    write_bytes_atomic(sheet, files.get(("train sheet", placements, planes), make_sheet))
+    written.append(sheet)
     return written
+
+
+def _cut(profile, tolerance: float):
+    """``(outline, tolerance used, pitch)`` of a profile, checked once (raising
+    :class:`DxfInputError` as :func:`write_gear_dxf` does) and thinned once."""
+    from cadgen.machine.hubs import cutting_outline
+
+    def check():
+        _raise_gear_problems(profile)
+        return True   # remembered only when no problem was raised
+
+    derived = getattr(profile, "derived", None)
+    derived(("dxf checked",), check) if derived else check()
+    cut = cutting_outline(profile, tolerance)
+    return cut.outline, cut.tolerance_used, cut.pitch
+
+
+class _CachedFiles:
+    """A written file's bytes from the gear cache, or made and stored there (no cache: made)."""
+
+    def __init__(self, cache, tolerance: float):
+        self.cache, self.tolerance = cache, tolerance
+
+    def get(self, inputs, make) -> bytes:
+        if self.cache is None:
+            return make()
+        from cadgen.gears.cache import file_key
+
+        key = file_key(inputs, chord_tolerance=self.tolerance, writer=writer_fingerprint())
+        stored = self.cache.get(key)
+        if isinstance(stored, bytes):
+            return stored
+        data = make()
+        self.cache.put(key, data)
+        return data
 
 
 def _mesh_planes(train, names: list) -> list:

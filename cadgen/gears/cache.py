@@ -1,10 +1,13 @@
-"""A content-addressed, on-disk cache of cut gear pairs (one :class:`~cadgen.gears.trains.GearStage`).
+"""A content-addressed, on-disk cache of cut gear pairs (one :class:`~cadgen.gears.trains.GearStage`)
+and of the files written for them.
 
 Cutting the teeth is the slowest stage of a build, and a designer iterating or a grid
 over the planter's lengths cuts the same gears again and again. A stage is stored under
 the SHA-256 of everything that determines it (:func:`stage_key`), so an entry is either
 exactly what the computation would give or is never looked up: there is no invalidation
-to get wrong, only keys.
+to get wrong, only keys. The bytes of a gear's DXF file and of the train sheet are stored
+likewise, under the SHA-256 of what they draw and of the writer (:func:`file_key`), so a
+warm build writes its gear files without making them.
 
 Entries are files ``<directory>/<key[:2]>/<key>.gear``: a fixed header (magic, format
 version, the SHA-256 of the payload, the payload's length) and the payload, a pickle
@@ -33,7 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["GearCache", "stage_key", "code_fingerprint", "CACHE_FORMAT", "FINGERPRINT_SAMPLES"]
+__all__ = ["GearCache", "stage_key", "file_key", "code_fingerprint", "CACHE_FORMAT",
+           "FINGERPRINT_SAMPLES"]
 
 #: Bump when the entry layout or the meaning of a key's fields changes.
 CACHE_FORMAT = 1
@@ -275,7 +279,9 @@ def _feed(digest, value) -> None:
             _feed(digest, item)
     elif dataclasses.is_dataclass(value):
         digest.update(f"{type(value).__qualname__}:".encode())
-        _feed(digest, {f.name: getattr(value, f.name) for f in dataclasses.fields(value)})
+        # fields left out of comparison (remembered derived values) say nothing of the value
+        _feed(digest, {f.name: getattr(value, f.name) for f in dataclasses.fields(value)
+                       if f.compare})
     else:
         raise TypeError(f"cannot key a gear stage on a {type(value).__name__}: {value!r}")
 
@@ -342,3 +348,38 @@ def stage_key(name: str, pair, teeth, system, *, flank_points: int, bore_radius:
     })
     return digest.hexdigest()
 
+
+def file_key(inputs, *, chord_tolerance: float, writer: str) -> str:
+    """The hex SHA-256 of everything that decides a written gear file's bytes.
+
+    Parameters
+    ----------
+    inputs : tuple
+        What the file draws, fed whole: ``("gear dxf", profile)`` (the bored
+        :class:`~cadgen.gears.teeth.GearProfile`: outline, pitch curve, module, bore, hole,
+        keyway angle, name) or ``("train sheet", placements, planes)``.
+    chord_tolerance : float
+        mm, the outline's thinning.
+    writer : str
+        The writer's fingerprint (its sources and ezdxf's version:
+        :func:`cadgen.export.dxf.writer_fingerprint`), from the caller: the gear package
+        does not import the writers.
+
+    Returns
+    -------
+    str
+        64 lowercase hexadecimal digits; also keyed: :data:`CACHE_FORMAT`, the
+        :func:`code_fingerprint` and the versions of numpy and shapely (GEOS), which thin
+        the outline.
+    """
+    import shapely
+
+    digest = hashlib.sha256()
+    _feed(digest, {
+        "format": CACHE_FORMAT, "code": code_fingerprint(), "writer": str(writer),
+        "libraries": f"numpy={np.__version__} shapely={shapely.__version__} "
+                     f"geos={shapely.geos_version_string} python={sys.version_info[:2]} "
+                     f"machine={platform.machine()}",
+        "chord_tolerance": float(chord_tolerance), "inputs": inputs,
+    })
+    return digest.hexdigest()

@@ -13,17 +13,19 @@ stage of a train is phased at its own start contact, so the train's phases agree
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 import shapely.errors
 
-from kinematics.arclength import ArcLengthCurve
 from kinematics.errors import DesignError
 
 from cadgen.gears.teeth import GearProfile
 from cadgen.gears.teeth import CutterChoice, ToothSystem, gear_outline
+
+if TYPE_CHECKING:   # scipy's splines behind it: imported where a non-circular curve is built
+    from kinematics.arclength import ArcLengthCurve
 
 __all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "generate_gear",
            "mating_phase", "circle_pair", "MIN_SHAPER_TEETH", "MIN_ROOT_THICKNESS",
@@ -65,14 +67,25 @@ class PitchPair:
     driven: object
     breaks: tuple = ()
     curve_periods: tuple = ()   # tau range in which each gear turns once (default: period)
+    radii: tuple = ()           # (drive, driven) pitch radii of a pair of circular gears
 
     def rotations(self, tau):
         """Body rotations (drive, driven) in rad that put the contact on the x axis."""
         tau = np.asarray(tau, dtype=float)
         return -self.drive(tau)[2], np.pi - self.driven(tau)[2]
 
-    def curve(self, which: int, samples: int = 4096) -> ArcLengthCurve:
+    def curve(self, which: int, samples: int = 4096):
+        """Gear ``which``'s pitch curve by arc length: an exact
+        :class:`~cadgen.gears.spur.CircleCurve` for a circular pair (``radii`` set), else an
+        :class:`~kinematics.arclength.ArcLengthCurve` of the contact functions."""
         functions = self.drive if which == 0 else self.driven
+        if self.radii:
+            from cadgen.gears.spur import CircleCurve
+
+            # the contact's polar angle is linear in tau on a circle: start and rate say it all
+            _, _, psi, rate = functions(np.zeros(1))
+            return CircleCurve(self.radii[which], float(psi[0]), float(rate[0]))
+        from kinematics.arclength import ArcLengthCurve
 
         def position(tau):
             rho, _, psi, _ = functions(tau)
@@ -104,7 +117,8 @@ def circle_pair(names, drive_radius: float, driven_radius: float) -> PitchPair:
                 np.full_like(tau, -ratio))
 
     return PitchPair(tuple(names), drive_radius + driven_radius, 2 * np.pi, drive, driven,
-                     curve_periods=(2 * np.pi, 2 * np.pi / ratio))
+                     curve_periods=(2 * np.pi, 2 * np.pi / ratio),
+                     radii=(float(drive_radius), float(driven_radius)))
 
 
 @dataclass(frozen=True)
@@ -189,6 +203,8 @@ def _tooth_thickness(frame, gear, teeth: int, pitch: float, phase: float, height
     width = np.zeros(teeth)
     if not pieces:
         return width
+    from scipy.spatial import cKDTree
+
     middles = shapely.get_coordinates(shapely.line_interpolate_point(pieces, 0.5, normalized=True))
     # each piece belongs to the tooth whose centre is nearest its middle along the curve
     nearest = s[cKDTree(offset).query(middles)[1]]
@@ -234,21 +250,7 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
     problems += _check_problems(name, concave, concave_min, shaper_teeth, system)
     limit = MIN_ROOT_THICKNESS * system.module
     undercut_root = float(root[undercut].min()) if undercut else None
-    if undercut:
-        thin = [k for k in undercut if root[k] < limit]
-        measured = (f"remaining root thickness down to {undercut_root:.3f} mm "
-                    f"({undercut_root / system.module:.3f} m)")
-        if thin:
-            problems.append(("undercut_root_too_thin",
-                             f"the {name} gear's teeth {_list(thin)} are undercut below the "
-                             f"root-thickness limit: {measured}, under {limit:.3f} mm "
-                             f"({MIN_ROOT_THICKNESS:g} m); use a smaller module (more teeth), a "
-                             "profile shift, or a shaper cutter"))
-        else:
-            problems.append(("undercut", f"the {name} gear's teeth {_list(undercut)} are "
-                             f"undercut; {measured}, at least the {limit:.3f} mm "
-                             f"({MIN_ROOT_THICKNESS:g} m) limit, so a warning: a smaller module "
-                             "(more teeth), a profile shift or a shaper cutter would avoid it"))
+    problems += _undercut_problems(name, undercut, root, limit, system)
     if pointed:
         problems.append(("pointed_teeth", f"the {name} gear's teeth {_list(pointed)} are pointed "
                          f"(tip thickness down to {tip.min():.3f} mm, below "
@@ -261,6 +263,28 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
         undercut_teeth=undercut, root_thickness_min=float(root.min()), pointed_teeth=pointed,
         tip_thickness_min=float(tip.min()), pressure_angle_deviation_max_deg=deviation,
         problems=problems, undercut_root_thickness_min=undercut_root, root_thickness_limit=limit)
+
+
+def _undercut_problems(name, undercut, root, limit, system) -> list:
+    """The undercut finding: a warning while the undercut teeth keep ``limit`` mm of root
+    thickness (``root``: per tooth), a failure below it; none without undercut teeth."""
+    if not undercut:
+        return []
+    root = np.asarray(root, dtype=float)
+    undercut_root = float(root[undercut].min())
+    thin = [k for k in undercut if root[k] < limit]
+    measured = (f"remaining root thickness down to {undercut_root:.3f} mm "
+                f"({undercut_root / system.module:.3f} m)")
+    if thin:
+        return [("undercut_root_too_thin",
+                 f"the {name} gear's teeth {_list(thin)} are undercut below the "
+                 f"root-thickness limit: {measured}, under {limit:.3f} mm "
+                 f"({MIN_ROOT_THICKNESS:g} m); use a smaller module (more teeth), a "
+                 "profile shift, or a shaper cutter")]
+    return [("undercut", f"the {name} gear's teeth {_list(undercut)} are "
+             f"undercut; {measured}, at least the {limit:.3f} mm "
+             f"({MIN_ROOT_THICKNESS:g} m) limit, so a warning: a smaller module "
+             "(more teeth), a profile shift or a shaper cutter would avoid it")]
 
 
 def _simple(geometry) -> bool:
@@ -323,8 +347,25 @@ def _check_problems(name, concave, concave_min, shaper_teeth, system):
 
 
 def generate_gear(name, curve: ArcLengthCurve, teeth: int, system: ToothSystem, phase: float, *,
-                  force_shaper: bool = False, bore_radius: float = 0.0, flank_points: int = 48):
-    """Tooth one gear (rack on convex stretches, shaper on concave ones) and check it."""
+                  force_shaper: bool = False, bore_radius: float = 0.0, flank_points: int = 48,
+                  symmetric: bool = True):
+    """Tooth one gear (rack on convex stretches, shaper on concave ones) and check it.
+
+    A :class:`~cadgen.gears.spur.CircleCurve` is cut by :func:`~cadgen.gears.spur.circular_gear`
+    (one tooth, turned) unless ``symmetric`` is False (every tooth, as any other curve).
+    """
+    if symmetric:
+        from cadgen.gears.spur import CircleCurve, circular_gear
+
+        if isinstance(curve, CircleCurve):
+            try:
+                return circular_gear(name, curve, teeth, system, phase,
+                                     force_shaper=force_shaper, bore_radius=bore_radius,
+                                     flank_points=flank_points)
+            except (ValueError, shapely.errors.GEOSException) as error:
+                raise DesignError.single(f"gears.{name.replace(' ', '_')}", "gear_not_cuttable",
+                                         f"the {name} gear cannot be cut: the tooth spaces do "
+                                         f"not form a valid outline ({error})") from None
     cutters, concave, concave_min, shaper_teeth = _choose_cutters(curve, teeth, system, phase,
                                                                   force_shaper)
     if shaper_teeth is not None and shaper_teeth < MIN_SHAPER_TEETH:
@@ -350,13 +391,15 @@ def generate_gear(name, curve: ArcLengthCurve, teeth: int, system: ToothSystem, 
 def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
                   system: ToothSystem | None = None, force_shaper: bool = False,
                   bore_radius: float = 0.0, flank_points: int = 48, drive_phase=None,
-                  drive_gear=None) -> GeneratedPair:
+                  drive_gear=None, symmetric: bool = True) -> GeneratedPair:
     """Tooth both gears of a pair, phased to assemble at ``tau = 0``, with their checks.
 
     ``teeth`` is one count or (drive, driven). The module follows from the
     perimeter (``P / (pi z)``) unless a tooth system is given. In a train, pass
     the drive's ``drive_phase`` and already generated ``drive_gear`` (profile,
-    check, spaces) so a gear in two meshes is cut once with one phase.
+    check, spaces) so a gear in two meshes is cut once with one phase. A circular pair
+    (:func:`circle_pair`) is cut on exact circles, one tooth turned (``symmetric``, see
+    :func:`generate_gear`).
     """
     teeth = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
     curves = (pair.curve(0), pair.curve(1))
@@ -370,7 +413,8 @@ def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
         # idler, which is half a pitch off for an odd tooth count)
         drive_phase = arc_at_angle(curves[0], drive_phase)
     phases = (drive_phase, mating_phase(curves[0], drive_phase, curves[1], system.pitch))
-    options = dict(force_shaper=force_shaper, bore_radius=bore_radius, flank_points=flank_points)
+    options = dict(force_shaper=force_shaper, bore_radius=bore_radius, flank_points=flank_points,
+                   symmetric=symmetric)
     first = drive_gear or generate_gear(pair.names[0], curves[0], teeth[0], system, phases[0],
                                         **options)
     second = generate_gear(pair.names[1], curves[1], teeth[1], system, phases[1], **options)

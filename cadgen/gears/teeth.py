@@ -23,11 +23,14 @@ the addendum curve) minus the union of all tooth spaces (shapely).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from kinematics.arclength import ArcLengthCurve
+if TYPE_CHECKING:   # only named in annotations: any curve with frame() and length will do
+    from kinematics.arclength import ArcLengthCurve
 
 __all__ = ["ToothSystem", "rack_tooth_outline", "rack_space_boundary", "shaper_space_boundary",
            "gear_outline", "CutterChoice", "GearProfile"]
@@ -136,6 +139,17 @@ def rack_tooth_outline(system: ToothSystem, *, flank_points: int = 48, fillet_po
     return xy, normal
 
 
+@functools.lru_cache(maxsize=32)
+def _rack_tooth(system: ToothSystem, *, flank_points: int = 48, fillet_points: int = 16):
+    """:func:`rack_tooth_outline`, remembered (read-only arrays): every space a rack cuts rolls
+    the same rack tooth."""
+    xy, normal = rack_tooth_outline(system, flank_points=flank_points,
+                                    fillet_points=fillet_points)
+    xy.setflags(write=False)
+    normal.setflags(write=False)
+    return xy, normal
+
+
 def rack_space_boundary(curve: ArcLengthCurve, centre: float, system: ToothSystem, **outline):
     """The envelope bounding one tooth space cut by a rack, in the gear frame.
 
@@ -151,7 +165,7 @@ def rack_space_boundary(curve: ArcLengthCurve, centre: float, system: ToothSyste
     (k, 2) float
         From the top of the left flank round the root to the top of the right.
     """
-    xy, normal = rack_tooth_outline(system, **outline)
+    xy, normal = _rack_tooth(system, **outline)
     x = xy[:, 0] + centre
     y = xy[:, 1]
     # the instant each rack point is on the envelope: its normal passes the pitch point
@@ -191,8 +205,12 @@ def shaper_space_boundary(curve: ArcLengthCurve, centre: float, system: ToothSys
                                      sin * xy[:, 0] + cos * xy[:, 1]], axis=-1)
 
 
+@functools.lru_cache(maxsize=32)
 def _shaper_tooth(system: ToothSystem, teeth: int, flank_points: int, fillet_points: int):
     """One tooth of a pinion cutter centred on the +x axis: outline, outward normals, pitch radius.
+
+    Remembered (read-only arrays): every space a shaper cuts rolls the same cutter tooth, and
+    its flank points come from a root search each.
 
     Involute flanks of the base circle ``r cos(alpha)``, thickness at the pitch
     circle equal to the gear's space (``p/2 + backlash``), tip at ``r + dedendum``
@@ -258,6 +276,8 @@ def _shaper_tooth(system: ToothSystem, teeth: int, flank_points: int, fillet_poi
     # order: from the top (root side) of the - flank, round the tip, to the + flank's root side
     xy = np.vstack([(upper * mirror), upper[::-1]])
     normal = np.vstack([(upper_n * mirror), upper_n[::-1]])
+    xy.setflags(write=False)
+    normal.setflags(write=False)
     return xy, normal, radius
 
 
@@ -472,6 +492,31 @@ class GearProfile:
     centre: tuple = (0.0, 0.0)
     notes: dict = field(default_factory=dict)
     hole: np.ndarray | None = None
+    # values computed from this profile by later stages (see derived()); a changed copy
+    # (dataclasses.replace) starts empty, and neither pickles nor compares nor keys a cache
+    _derived: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def derived(self, key, compute):
+        """``compute()`` the first time ``key`` is asked for on this profile, then remembered.
+
+        For what several stages need from one cut gear (its thinned cutting outline: the
+        solid, its DXF file and the train sheet); ``key`` must name everything besides the
+        profile that the value depends on (a tolerance, say).
+        """
+        try:
+            return self._derived[key]
+        except KeyError:
+            value = self._derived[key] = compute()
+            return value
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["_derived"] = {}
+        return state
+
+    def __setstate__(self, state):
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
 
     @property
     def hole_reach(self) -> float:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -41,6 +41,8 @@ class GearTrain:
     stages: tuple
     failures: tuple = ()   # (stage name, Problem) for stages whose gears cannot be cut
     rims: tuple = ()       # cadgen.machine.hubs.RimCheck per gear, once bored for its shaft
+    # the gear cache the train was cut with (or None): its files are looked up there too
+    cache: object = field(default=None, repr=False, compare=False)
 
     @property
     def gears(self):
@@ -113,12 +115,15 @@ def _cut_stage(name, pair, teeth, system, bore, force_shaper, flank_points, plac
     if report.overlap_area_max > 0.0 and drive is None:
         # tip interference (a shaper-cut concave stretch against a tight convex one, say):
         # relieve the drive's tips by what its mate sweeps there, then check again
-        outline, area, depth = relieve_interference(generated.profiles[0], generated.profiles[1],
-                                                    pair, report)
+        original = generated.profiles[0]
+        outline, area, depth = relieve_interference(original, generated.profiles[1], pair,
+                                                    report)
         relieved = dataclasses.replace(generated.profiles[0], outline=outline)
         generated = dataclasses.replace(generated, profiles=(relieved, generated.profiles[1]))
         before = report
-        report = meshing_check(relieved, generated.profiles[1], pair, poses=poses, span=span)
+        # the relief changes the drive's tips near a few poses: the others keep their results
+        report = meshing_check(relieved, generated.profiles[1], pair, poses=poses, span=span,
+                               previous=(before, original.outline))
         relief = {"gear": relieved.name, "removed_area_mm2": area, "depth_mm": depth,
                   "overlap_before_mm2": before.overlap_area_max,
                   "interfering_poses_before": before.interference_poses}
@@ -208,7 +213,7 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
                    system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
                    drive=_carry(second.generated), circular=True, cache=cache)
     cut(third.name)
-    return GearTrain(tuple(stages + [first, second, third]))
+    return GearTrain(tuple(stages + [first, second, third]), cache=cache)
 
 
 def pricking_train(params, design, progress=None, cache=None) -> GearTrain:
@@ -237,7 +242,7 @@ def pricking_train(params, design, progress=None, cache=None) -> GearTrain:
         except DesignError as error:  # reported with the gear and the reason; others go on
             failures += [(f"stage {index + 1}", problem) for problem in error.problems]
         cut(f"stage {index + 1}")
-    return GearTrain(tuple(stages), tuple(failures))
+    return GearTrain(tuple(stages), tuple(failures), cache=cache)
 
 
 def _placements(train: GearTrain):

@@ -15,6 +15,10 @@ usual hard minimum below which the rim itself cracks between a root and the keyw
 A non-circular gear's root lies at different radii round the gear, so the keyway is turned to
 where it leaves the thickest rim (:func:`best_keyway_angle`).
 
+The outline a bored gear is cut along (:func:`cutting_outline`: thinned to the chord tolerance,
+kept clear of the hole's reach) is made here once per gear and tolerance, for the solid, the
+gear's DXF file and the train sheet alike.
+
 numpy and shapely only (shapely imported inside the functions).
 """
 
@@ -28,8 +32,9 @@ import numpy as np
 
 from kinematics.errors import Problem
 
-__all__ = ["MIN_RIM_MODULES", "WARN_RIM_MODULES", "KEYWAY_ANGLE_STEPS", "RimCheck", "hub_hole",
-           "best_keyway_angle", "rim_thickness", "rim_check", "hub_train"]
+__all__ = ["MIN_RIM_MODULES", "WARN_RIM_MODULES", "KEYWAY_ANGLE_STEPS", "KEYWAY_TIE_TOLERANCE",
+           "RimCheck", "CuttingOutline", "hub_hole", "best_keyway_angle", "rim_thickness",
+           "rim_check", "hub_train", "cutting_outline"]
 
 #: Rim under the hole below this many modules fails (``rim_too_thin``): the common hard minimum
 #: of a gear's rim (one module), below which the rim cracks between the root and the bore.
@@ -39,6 +44,11 @@ MIN_RIM_MODULES = 1.0
 WARN_RIM_MODULES = 2.5
 #: Directions scanned by :func:`best_keyway_angle` (a 0.5 deg step).
 KEYWAY_ANGLE_STEPS = 720
+#: mm: directions whose rim is within this of the thickest are tied and the first (the smallest
+#: angle) wins. A circular gear's teeth give z directions equal but for rounding (1e-14 mm
+#: apart), which must not decide; a non-circular gear's best direction stands out by far more
+#: (0.01 mm and up on the bundled designs).
+KEYWAY_TIE_TOLERANCE = 1e-6
 #: Samples per scanned direction when a ring is resampled for the radial profiles: every bin
 #: of the scan then holds points of both rings.
 _SAMPLES_PER_STEP = 8
@@ -216,9 +226,9 @@ def best_keyway_angle(outline, hole_fn, *, steps: int = KEYWAY_ANGLE_STEPS) -> f
     radius in each of ``steps`` angular bins; turning the hole by ``k`` bins leaves the radial
     rim ``min over bins (outline(b) - hole(b - k))`` under the part of the hole reaching beyond
     its circle (the keyway; a D-flat: the whole hole, so the flat faces the nearest root); the
-    first largest wins. A circular gear's
-    rims differ only by how the keyway's corners fall against the roots, so the choice there is
-    deterministic but of no consequence. :func:`rim_thickness` measures the chosen hole exactly.
+    first largest wins (within :data:`KEYWAY_TIE_TOLERANCE`). A circular gear's rims differ
+    only by how the keyway's corners fall against the roots: its z equivalent directions tie
+    and the first of them is taken. :func:`rim_thickness` measures the chosen hole exactly.
 
     Parameters
     ----------
@@ -251,10 +261,13 @@ def best_keyway_angle(outline, hole_fn, *, steps: int = KEYWAY_ANGLE_STEPS) -> f
     beyond = inner > circle * (1 + 1e-9)
     if not beyond.any():
         beyond = np.ones(steps, dtype=bool)
-    # hole turned by k bins: its bin b holds what bin (b - k) held at angle 0
-    shift = np.mod(np.arange(steps)[None, :] - np.arange(steps)[:, None], steps)
-    rim = np.min(np.where(beyond[shift], outer[None, :] - inner[shift], np.inf), axis=1)
-    return float(np.argmax(rim) * 2 * np.pi / steps)
+    # hole turned by k bins: its bin b lands on bin (b + k); only the bins beyond the circle
+    # count, so the scan is (turns x those bins), the same differences as the full table
+    bins = np.flatnonzero(beyond)
+    landed = np.mod(np.arange(steps)[:, None] + bins[None, :], steps)
+    rim = np.min(outer[landed] - inner[bins][None, :], axis=1)
+    best = int(np.flatnonzero(rim >= rim.max() - KEYWAY_TIE_TOLERANCE)[0])
+    return float(best * 2 * np.pi / steps)
 
 
 def rim_thickness(outline, hole):
@@ -375,3 +388,53 @@ def hub_train(train, drivetrain, *, key_slot_allowance: float = 0.0, segments: i
         stages.append(dataclasses.replace(
             stage, generated=dataclasses.replace(stage.generated, profiles=profiles)))
     return dataclasses.replace(train, stages=tuple(stages)), tuple(checks)
+
+
+# --------------------------------------------------------------------------- the cut outline
+
+
+@dataclass(frozen=True)
+class CuttingOutline:
+    """A gear's outline as cut, in its body frame (see :func:`cutting_outline`).
+
+    Attributes
+    ----------
+    outline : (n, 2) float
+        Thinned, counter-clockwise, the first point not repeated; read-only.
+    tolerance_used : float
+        mm, every point of the dense outline lies within this of ``outline`` (``0.0``: the
+        dense outline kept as is).
+    pitch : (m, 2) float
+        The pitch curve thinned to the same tolerance; read-only.
+    """
+
+    outline: np.ndarray
+    tolerance_used: float
+    pitch: np.ndarray
+
+
+def cutting_outline(profile, chord_tolerance: float) -> CuttingOutline:
+    """The outline ``profile`` is cut along: thinned to ``chord_tolerance`` (mm) by
+    :func:`cadgen.geometry.contour.thin_outline`, simple and clear of the disc of the hole's
+    reach (``profile.hole_reach``), and its pitch curve thinned likewise.
+
+    Computed once per profile and tolerance (remembered on the profile, see
+    :meth:`~cadgen.gears.teeth.GearProfile.derived`): the solid, the gear's DXF file and the
+    train sheet all draw this one. The tolerance must be finite and > 0 (the DXF writer
+    checks it and names it).
+    """
+    tolerance = float(chord_tolerance)
+
+    def compute():
+        from cadgen.geometry.contour import closed_points, thin_outline, thin_ring
+
+        reach = float(getattr(profile, "hole_reach", profile.bore_radius))
+        outline, used = thin_outline(closed_points(profile.outline), tolerance, profile.centre,
+                                     reach)
+        pitch, _ = thin_ring(closed_points(profile.pitch_curve), tolerance)
+        for array in (outline, pitch):
+            array.setflags(write=False)   # shared by every stage that asks
+        return CuttingOutline(outline, used, pitch)
+
+    derived = getattr(profile, "derived", None)
+    return derived(("cutting outline", tolerance), compute) if derived else compute()

@@ -186,26 +186,27 @@ class _Build:
         return next((r.status for r in self.records if r.stage == stage), "not run")
 
     def run(self, functions: dict) -> None:
-        ahead = None
+        beside = None      # the forked worker's future (see _start_beside)
         for stage in self.stages:
-            if stage == "teeth" and ahead is None:
-                ahead = _start_sweeps_ahead(self, functions)
+            if stage == "teeth" and beside is None:
+                from cadgen.pipeline.beside import start_beside
+
+                beside = start_beside(self, functions)
+            if beside is not None and stage in beside.sweeps:
+                continue            # the worker's: collected with its figures (_collect)
             failed = [need for need in STAGE_NEEDS[stage]
                       if need in self.stages and self.status(need) != "ok"]
-            if ahead is not None and stage in SWEEP_STAGES:
-                outcomes = ahead.result()
-                self.progress.join()    # the worker's events, all delivered
             if failed:
                 record = StageRecord(stage, "skipped", message=(
                     f"needs {', '.join(failed)}, which did not complete"))
                 self.records.append(record)
                 self.progress.finished(stage, "skipped", 0.0, detail=record.message)
                 continue
-            if ahead is not None and stage in SWEEP_STAGES:
-                record, value = outcomes[stage]
-                if stage not in self.progress.finished_stages():   # the worker said nothing
-                    self.progress.finished(stage, record.status, record.seconds,
-                                           detail=record.message, beside=True)
+            if beside is not None and stage == "plots":
+                from cadgen.pipeline.beside import plots_beside
+
+                record, value = plots_beside(self, beside)
+                beside = None
             else:
                 self.progress.started(stage)
                 record, value = _run_stage(self, stage, functions)
@@ -214,6 +215,11 @@ class _Build:
             self.records.append(record)
             if record.status == "ok":
                 self.values[stage] = value
+        if beside is not None:
+            from cadgen.pipeline.beside import collect
+
+            collect(self, beside)
+        self.records.sort(key=lambda record: STAGE_ORDER.index(record.stage))
 
 
 def _run_stage(run, stage: str, functions: dict):
@@ -232,70 +238,8 @@ def _run_stage(run, stage: str, functions: dict):
     return StageRecord(stage, "ok", time.perf_counter() - start), value
 
 
-#: The FCL sweeps, which need the solids but not the gears: on a machine that can fork they
-#: run in a worker on a gearless assembly while this process cuts the teeth (same results:
-#: no gear is in a sweep).
+#: The FCL sweeps (run beside the teeth where they can: :mod:`cadgen.pipeline.beside`).
 SWEEP_STAGES = ("arm_interference", "ground_clearance")
-_AHEAD: dict = {}
-
-
-def _start_sweeps_ahead(run, functions):
-    import multiprocessing
-
-    from cadgen.pipeline.figures import _can_fork
-
-    sweeps = [s for s in SWEEP_STAGES if s in run.stages]
-    if not sweeps or "teeth" not in run.stages or not _can_fork() \
-            or run.status("metrics") != "ok":
-        return None
-    from concurrent.futures import ProcessPoolExecutor
-
-    ends = run.progress.pipe()
-    _AHEAD.update(run=run, functions=functions, sweeps=sweeps,
-                  events=ends[1] if ends else None)
-    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
-    try:
-        future = pool.submit(_sweeps_ahead)   # forks the worker here
-    finally:
-        _AHEAD.clear()              # the forked worker has its own copy
-        if ends:
-            run.progress.relay(ends[0])
-            ends[1].close()         # the worker's copy is the last: its end is the relay's
-    pool.shutdown(wait=False)   # the worker ends after its one task
-    return future
-
-
-def _sweeps_ahead() -> dict:
-    """In the forked worker: the gearless parts, then each sweep; ``{stage: (record, value)}``."""
-    run, functions, sweeps = _AHEAD["run"], _AHEAD["functions"], _AHEAD["sweeps"]
-    events, progress = _AHEAD.get("events"), run.progress
-    if events is not None:
-        progress.forward(events)
-    try:
-        progress.started("parts", detail="without gears, for the sweeps", beside=True)
-        parts_record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
-        progress.finished("parts", parts_record.status, parts_record.seconds,
-                          detail=parts_record.message or "without gears, for the sweeps",
-                          beside=True)
-        out = {}
-        for stage in sweeps:
-            if parts_record.status != "ok":
-                record = StageRecord(stage, "skipped",
-                                     message="needs parts, which did not complete")
-                progress.finished(stage, "skipped", 0.0, detail=record.message, beside=True)
-                out[stage] = (record, None)
-                continue
-            run.values["parts"] = parts
-            progress.started(stage, beside=True)
-            record, value = _run_stage(run, stage, functions)
-            record.message = record.message or "ran beside the teeth, in a second process"
-            progress.finished(stage, record.status, record.seconds, detail=record.message,
-                              beside=True)
-            out[stage] = (record, value)
-        return out
-    finally:
-        if events is not None:
-            events.close()          # the relay's end of file
 
 
 # --------------------------------------------------------------------------- stages
@@ -394,7 +338,7 @@ def _arm_interference(run):
     from cadgen.pipeline.clearances import arm_interference
 
     return arm_interference(run.params, run.values["kinematics"], run.values["parts"],
-                            run.values.get("cam"))
+                            run.values.get("cam"), evaluation=run.values.get("metrics"))
 
 
 def _ground_clearance(run):

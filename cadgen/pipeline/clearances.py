@@ -21,7 +21,10 @@ angle (see that module for the formula ``v + w * reach + u``):
   from E plus that reach, however far it opens;
 * gearbox 1 (base and cover) turns about O at rate 1; the ground is fixed.
 
-The pair's bound is the sum of the two groups' (arm 2 moves like arm 1). The
+Each part instance gets its own part's bounds (arm 2 moves like arm 1), and a pair
+of parts is certified with the sum of its two parts' (a cam against a planter shell
+with theirs, not the fastest blade's): :func:`cadgen.sweep.search.certified_distance`
+with ``instance_bounds``; the report's Lipschitz constant is the largest pair's. The
 result replaces the kinematic estimate (centre lines, envelope circles) of the
 metric; the report keeps both.
 """
@@ -39,7 +42,7 @@ __all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
 #: assembly are skipped (no cam without a cuttable cam design, ...).
 ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "shaft-E", "cam",
              "planter-shell", "blade-right", "blade-left")
-#: The parts fixed in gearbox 2's body (the first group of :func:`_arm_bounds`).
+#: The parts fixed in gearbox 2's body (the first group of :func:`_arm_part_bounds`).
 _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
 #: Gearbox 2's shafts, turning on their axes with their gears.
 _GEARBOX2_SHAFTS = ("shaft-C2", "shaft-D", "shaft-E")
@@ -101,17 +104,23 @@ def _shaft_rates(mechanism, samples: int = 20_000):
             SAMPLED_MARGIN * float(np.max(np.abs(np.gradient(rate, step)))))
 
 
-def _arm_bounds(mechanism, parts, cam):
+def _arm_bounds(mechanism, parts, cam) -> tuple:
     """(speed, acceleration) bounds of any point of one arm's parts that are present."""
+    bounds = _arm_part_bounds(mechanism, parts, cam)
+    return (max(speed for speed, _ in bounds.values()),
+            max(acceleration for _, acceleration in bounds.values()))
+
+
+def _arm_part_bounds(mechanism, parts, cam) -> dict:
+    """``{part: (speed, acceleration)}`` bounds of any point of each of one arm's parts present."""
     from cadgen.sweep.scene import part_reach
 
     rc = mechanism.carrier_radii["C"]
     spin, turn = _planter_turn(mechanism)
-    speed, acceleration = [], []
+    bounds = {}
     for name in _present(_GEARBOX2_FIXED, parts):
         box = rc + part_reach(parts[name], axis=_Z)
-        speed.append(box)
-        acceleration.append(box)
+        bounds[name] = (box, box)
     shafts = [name for name in _GEARBOX2_SHAFTS if name in parts]
     if shafts:
         rate, rate_rate = _shaft_rates(mechanism)
@@ -119,12 +128,12 @@ def _arm_bounds(mechanism, parts, cam):
             shaft = parts[name]
             radius = float(np.max(np.linalg.norm(shaft.mesh.vertices[:, :2], axis=1)))
             reach = float(np.hypot(*shaft.local(0.0)[:2, 3])) + radius
-            speed.append(rc + reach + rate * radius)
-            acceleration.append(rc + reach + (2 * rate + rate**2 + rate_rate) * radius)
+            bounds[name] = (rc + reach + rate * radius,
+                            rc + reach + (2 * rate + rate**2 + rate_rate) * radius)
     if "planter-shell" in parts:
         reach = part_reach(parts["planter-shell"], axis=_Z)
-        speed.append(mechanism.speed_bound("E") + spin * reach)
-        acceleration.append(mechanism.acceleration_bound("E") + turn * reach)
+        bounds["planter-shell"] = (mechanism.speed_bound("E") + spin * reach,
+                                   mechanism.acceleration_bound("E") + turn * reach)
     blades = [name for name in ("blade-right", "blade-left") if name in parts]
     if blades:
         rate, rate_rate = _blade_rates(cam, mechanism) if cam is not None else (0.0, 0.0)
@@ -137,10 +146,10 @@ def _arm_bounds(mechanism, parts, cam):
                 reach_h = part_reach(blade, body_origin_local=(*hinge, 0.0), axis=_Z)
                 # however far it opens, no point of it is farther from E than this
                 reach_e = float(np.hypot(*hinge)) + reach_h
-            speed.append(mechanism.speed_bound("E") + spin * reach_e + rate * reach_h)
-            acceleration.append(mechanism.acceleration_bound("E") + turn * reach_e
-                                + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
-    return max(speed), max(acceleration)
+            bounds[name] = (mechanism.speed_bound("E") + spin * reach_e + rate * reach_h,
+                            mechanism.acceleration_bound("E") + turn * reach_e
+                            + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
+    return bounds
 
 
 def _hinge(linkage, blade: str) -> np.ndarray:
@@ -182,12 +191,24 @@ def _section(result, label, target, kinematic) -> dict:
     }
 
 
+def _fixed_ground(reach: dict) -> dict:
+    """Instance bounds of housings turning at rate 1 (speed and acceleration both their reach),
+    and of the fixed ground."""
+    bounds = {name: (value, value) for name, value in reach.items()}
+    bounds["ground"] = (0.0, 0.0)
+    return bounds
+
+
 def _kinematic(evaluation, key):
     return next(m.value for m in evaluation.metrics if m.key == key)
 
 
-def arm_interference(params, mechanism, solids, cam) -> dict:
-    """Certified least distance between the two planting arms' solids over a revolution."""
+def arm_interference(params, mechanism, solids, cam, evaluation=None) -> dict:
+    """Certified least distance between the two planting arms' solids over a revolution.
+
+    ``evaluation`` (the metrics stage's) supplies the kinematic estimate beside it;
+    without it the estimate is computed again.
+    """
     from cadgen.sweep.fcl import FclScene
     from cadgen.sweep.search import certified_distance
 
@@ -195,12 +216,18 @@ def arm_interference(params, mechanism, solids, cam) -> dict:
     parts = {part.name: part for part in assembly.parts}
     present = _present(ARM_PARTS, parts)
     scene = FclScene(assembly, [f"{n}-arm1" for n in present], [f"{n}-arm2" for n in present])
-    speed, acceleration = _arm_bounds(mechanism, parts, cam)
-    # arm 2 is arm 1 half a turn on, so the distance repeats every half turn
+    bounds = _arm_part_bounds(mechanism, parts, cam)
+    # arm 2 moves like arm 1, half a turn on: each instance has its part's bounds, and the
+    # distance repeats every half turn
+    speed = max(value for value, _ in bounds.values())
+    acceleration = max(value for _, value in bounds.values())
     result = certified_distance(scene, lipschitz=2 * speed, acceleration=2 * acceleration,
                                 upper=math.pi, atol=params.resolution.sweep_atol,
-                                steps=SWEEP_STEPS)
-    kinematic = _arm_distance_estimate(params, mechanism)
+                                steps=SWEEP_STEPS,
+                                instance_bounds={f"{name}-{arm}": bounds[name]
+                                                 for name in present for arm in ("arm1", "arm2")})
+    kinematic = (_kinematic(evaluation, "arm_distance") if evaluation is not None
+                 else _arm_distance_estimate(params, mechanism))
     return _section(result, "arm distance (solids, FCL)", params.targets.arm_distance_min,
                     kinematic)
 
@@ -224,21 +251,27 @@ def ground_clearance(params, design, solids, field) -> dict:
         housings = _present(["gear-case-base", "gear-case-cover"], parts)
         # the case turns about O at rate 1 (a point of it moves at most its reach from O)
         centre = (*np.asarray(link.centre, dtype=float), 0.0)
-        speed = max(part_reach(parts[name], body_origin_local=centre, axis=_Z)
-                    for name in housings)
+        reach = {name: part_reach(parts[name], body_origin_local=centre, axis=_Z)
+                 for name in housings}
+        speed = max(reach.values())
         result = certified_distance(FclScene(assembly, housings, ["ground"]), lipschitz=speed,
                                     acceleration=speed, atol=params.resolution.sweep_atol,
-                                    steps=SWEEP_STEPS)
+                                    steps=SWEEP_STEPS, instance_bounds=_fixed_ground(reach))
         # the case must stay out of the soil (no kinematic estimate for this mechanism)
         return _section(result, "gear case ground clearance (solids, FCL)", 0.0, None)
     rc = design.carrier_radii["C"]
     box1 = _present(_GROUND_HOUSINGS["gearbox1"], parts)
     box2 = _present(_GROUND_HOUSINGS["gearbox2"], parts)
     housings = list(box1) + [f"{name}-{arm}" for name in box2 for arm in ("arm1", "arm2")]
-    speed = max(max(part_reach(parts[name], axis=_Z) for name in box1),
-                rc + max(part_reach(parts[name], axis=_Z) for name in box2))
+    # gearbox 1 turns about O at rate 1; gearbox 2 about C, which circles at rc (a point
+    # moves at most its reach, and accelerates at most the same, per radian)
+    reach = {name: part_reach(parts[name], axis=_Z) for name in box1}
+    reach.update({f"{name}-{arm}": rc + part_reach(parts[name], axis=_Z)
+                  for name in box2 for arm in ("arm1", "arm2")})
+    speed = max(reach.values())
     scene = FclScene(assembly, housings, ["ground"])
     result = certified_distance(scene, lipschitz=speed, acceleration=speed,
-                                atol=params.resolution.sweep_atol, steps=SWEEP_STEPS)
+                                atol=params.resolution.sweep_atol, steps=SWEEP_STEPS,
+                                instance_bounds=_fixed_ground(reach))
     return _section(result, "gearbox ground clearance (solids, FCL)",
                     params.targets.ground_clearance_min, _kinematic(field, "ground_clearance"))

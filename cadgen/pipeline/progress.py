@@ -96,11 +96,12 @@ class StageProgress:
     def started(self, stage: str, *, steps: int = 0, detail: str = "", beside: bool = False):
         if self._forwarded("started", stage, steps=steps, detail=detail, beside=beside):
             return
+        key = (stage, beside)    # a stage can run in both processes (the figures): two counts
         with self._lock:
             now = time.perf_counter()
-            self._begun[stage] = now
-            self._done[stage] = 0
-            self._steps[stage] = steps
+            self._begun[key] = now
+            self._done[key] = 0
+            self._steps[key] = steps
             self._emit(ProgressEvent(stage, "started", 0, steps, 0.0, now - self.start,
                                      detail=detail, beside=beside))
 
@@ -109,26 +110,28 @@ class StageProgress:
         """One more step of ``stage`` done (``steps``: the total, when it becomes known)."""
         if self._forwarded("step", stage, detail, steps=steps, beside=beside):
             return
+        key = (stage, beside)
         with self._lock:
             now = time.perf_counter()
             if steps is not None:
-                self._steps[stage] = steps
-            done = self._done[stage] = self._done.get(stage, 0) + 1
-            self._emit(ProgressEvent(stage, "step", done, self._steps.get(stage, 0),
-                                     now - self._begun.get(stage, now), now - self.start,
+                self._steps[key] = steps
+            done = self._done[key] = self._done.get(key, 0) + 1
+            self._emit(ProgressEvent(stage, "step", done, self._steps.get(key, 0),
+                                     now - self._begun.get(key, now), now - self.start,
                                      detail=detail, beside=beside))
 
     def finished(self, stage: str, status: str, seconds: float | None = None, *,
                  detail: str = "", beside: bool = False):
         if self._forwarded("finished", stage, status, seconds, detail=detail, beside=beside):
             return
+        key = (stage, beside)
         with self._lock:
             now = time.perf_counter()
             if seconds is None:
-                seconds = now - self._begun.get(stage, now)
+                seconds = now - self._begun.get(key, now)
             self._finished.add(stage)
-            self._emit(ProgressEvent(stage, "finished", self._done.get(stage, 0),
-                                     self._steps.get(stage, 0), seconds, now - self.start,
+            self._emit(ProgressEvent(stage, "finished", self._done.get(key, 0),
+                                     self._steps.get(key, 0), seconds, now - self.start,
                                      status=status, detail=detail, beside=beside))
 
     def _emit(self, event: ProgressEvent) -> None:

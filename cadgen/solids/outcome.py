@@ -154,8 +154,9 @@ def printing_pose(mesh, *, support_rtol: float = SUPPORT_RTOL,
     if len(mesh.faces) == 0 or not np.isfinite(vertices).all():
         raise ValueError(f"a printing pose needs a finite mesh with faces, not {len(mesh.faces)} "
                          f"faces")
-    hull = mesh.convex_hull
-    extreme = np.asarray(hull.vertices, dtype=float)
+    # a linear function's maximum over the vertices is its maximum over their hull: the
+    # support test needs no 3D hull (qhull is the slow part), only the fallback does
+    extreme = vertices
     tolerance = support_rtol * max(float(mesh.scale), 1.0)
     areas, normals, points = _flat_faces(mesh)
     best = None
@@ -167,6 +168,8 @@ def printing_pose(mesh, *, support_rtol: float = SUPPORT_RTOL,
         if best is None or normals[index][2] < normals[best][2]:
             best = index      # among equal faces, the one facing down already
     if best is None:
+        hull = mesh.convex_hull
+        extreme = np.asarray(hull.vertices, dtype=float)
         hull_areas, hull_normals, _ = _flat_faces(hull)
         normal = hull_normals[int(np.argmax(hull_areas))]
     else:

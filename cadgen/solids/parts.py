@@ -106,7 +106,7 @@ def gear_solid(profile, face_width: float, segments: int, path: str, chord_toler
     the profile's ``hole`` (bore with keyway or D-flat, body frame) when set, else a
     ``segments``-gon of ``bore_radius``.
     """
-    from cadgen.geometry.contour import thinned_contour
+    from cadgen.machine.hubs import cutting_outline
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import circle
 
@@ -115,8 +115,7 @@ def gear_solid(profile, face_width: float, segments: int, path: str, chord_toler
         holes = [np.asarray(hole, dtype=float)]
     else:
         holes = [circle(profile.bore_radius, segments, profile.centre)] if profile.bore_radius > 0 else []
-    # the keep-clear disc as the DXF writer's (cadgen.export.dxf._thin_gear): the same outline
-    outline = thinned_contour(profile.outline, chord_tolerance, centre=profile.centre,
-                              bore_radius=getattr(profile, "hole_reach", profile.bore_radius))
+    # the outline the gear's DXF holds, thinned and checked once for both
+    outline = cutting_outline(profile, chord_tolerance).outline
     return extrude(outline, face_width, holes=holes, path=path,
                    outline_path=f"gear {profile.name!r} outline"), outline

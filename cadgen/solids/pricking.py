@@ -37,14 +37,19 @@ from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
 __all__ = ["pricking_assembly"]
 
 
+def _carrier_angle(design, angle):
+    """Carrier angle ``phi1`` after the carrier turned by ``angle``: ``(phi1 in its first turn,
+    phi1)``."""
+    motion = design.motion
+    turns, rest = divmod(float(angle), 2 * math.pi)
+    phi1 = motion.phi1_start + motion.sense * rest
+    return phi1, phi1 + motion.sense * 2 * math.pi * turns
+
+
 def _pose_parameters(design, angle):
     """Curve parameter ``v`` and carrier angle ``phi1`` after the carrier turned by ``angle``."""
-    motion = design.motion
-    start = motion.phi1_start
-    turns, rest = divmod(float(angle), 2 * math.pi)
-    phi1 = start + motion.sense * rest
-    v = float(motion.invert(np.array([phi1]))[0])
-    return v, phi1 + motion.sense * 2 * math.pi * turns
+    first, phi1 = _carrier_angle(design, angle)
+    return float(design.motion.invert(np.array([first]))[0]), phi1
 
 
 def pricking_assembly(params, design, train, field, *, drivetrain=None):
@@ -87,7 +92,8 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
         return poses[angle]
 
     def carrier_pose(angle):
-        v, phi1 = pose_of(angle)
+        # the case turns with the carrier: no inverse solve (the planet's pose needs one)
+        _, phi1 = _carrier_angle(design, angle)
         return planar_transform(phi1 - start, centre) @ planar_transform(0.0, -centre)
 
     def planet_pose(angle):

@@ -1,10 +1,15 @@
 """The sweep of the solids through a revolution: certified least distance and interference.
 
-Three modules, one concept each:
+Five modules, one concept each:
 
 - :mod:`cadgen.sweep.scene`: part instances, their poses and reach (the Lipschitz
-  bound's geometric factor), and the scene interface a search asks of an engine;
+  bound's geometric factor), and the scene interfaces a search asks of an engine;
 - :mod:`cadgen.sweep.search`: the certified search over poses, engine-agnostic;
+- :mod:`cadgen.sweep.pairwise`: the same search pair of parts by pair, each with
+  its own speed bounds, climbing from cheap lower bounds to exact distances only
+  where the certificate needs them;
+- :mod:`cadgen.sweep.proxies`: convex-hull lower bounds of a distance, and the
+  certificates that make them exact (numpy only);
 - :mod:`cadgen.sweep.fcl`: the python-fcl adapter (:class:`FclScene`).
 
 The public names below are imported on first use (PEP 562): importing fcl is
@@ -18,6 +23,7 @@ from importlib import import_module
 _EXPORTS = {
     "Proximity": "cadgen.sweep.scene",
     "SweepScene": "cadgen.sweep.scene",
+    "PairScene": "cadgen.sweep.scene",
     "instance_pose": "cadgen.sweep.scene",
     "part_reach": "cadgen.sweep.scene",
     "FclScene": "cadgen.sweep.fcl",

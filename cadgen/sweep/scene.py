@@ -3,8 +3,9 @@
 The engine-agnostic side of the clearance checks, numpy only. A sweep scene is
 two groups of an assembly's part instances that follow the carrier angle
 ``phi``; :class:`SweepScene` is what the certified search
-(:mod:`cadgen.sweep.search`) asks of one, and :class:`Proximity` is the answer
-of one pose. The FCL adapter (:class:`cadgen.sweep.fcl.FclScene`) is the engine
+(:mod:`cadgen.sweep.search`) asks of one, :class:`PairScene` what the pair-by-pair
+search (:mod:`cadgen.sweep.pairwise`) asks on top, and :class:`Proximity` is the
+answer of one pose. The FCL adapter (:class:`cadgen.sweep.fcl.FclScene`) is the engine
 that answers.
 
 Lipschitz bound (the caller's, mm per rad of carrier angle). For one body
@@ -31,7 +32,8 @@ import numpy as np
 
 from cadgen.solids.errors import SolidInputError
 
-__all__ = ["Proximity", "SweepScene", "part_instances", "instance_pose", "part_reach"]
+__all__ = ["Proximity", "SweepScene", "PairScene", "part_instances", "instance_pose",
+           "part_reach"]
 
 
 class Proximity(NamedTuple):
@@ -67,6 +69,29 @@ class SweepScene(Protocol):
 
     def distances(self, phis) -> np.ndarray:
         """Distances ``(n,)`` at carrier angles ``phis`` ``(n,)``."""
+
+
+class PairScene(SweepScene, Protocol):
+    """A sweep scene that also answers pair by pair (what :mod:`cadgen.sweep.pairwise` needs).
+
+    ``pairs`` lists every (instance of A, instance of B); the group distance is
+    the least of theirs. Each answer at ``phi`` is a true bound: ``lower_bounds``
+    and the ``lower`` of ``refine`` never exceed the pair's distance, ``attained``
+    is the distance of two points of the two solids, and a Proximity is the
+    pair's distance itself.
+    """
+
+    pairs: list
+
+    def lower_bounds(self, phi: float, pairs=None) -> np.ndarray:
+        """Cheap lower bounds (P,) of the pairs' distances (-inf outside the ``pairs`` mask)."""
+
+    def refine(self, phi: float, pair: int, below: float = np.inf) -> tuple:
+        """``(lower, attained, Proximity or None)`` of one pair: a better bound, exact when it
+        can be shown so (looked for only below ``below``)."""
+
+    def exact(self, phi: float, pair: int, lower: float = 0.0) -> Proximity:
+        """The pair's distance (0 when the solids overlap; ``lower`` > 0 rules that out)."""
 
 
 def part_instances(assembly) -> dict:

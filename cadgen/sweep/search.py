@@ -76,6 +76,10 @@ class SweepResult:
         As given (``acceleration`` None when not given).
     seconds : float
         Wall time of the sweep.
+    certificate : (n, 3) float or None
+        The search's final partition of ``[lower, upper]``: each interval's ends
+        (rad) and the lower bound of the distance proved on it (mm); the least
+        is ``bound``. None for a scene searched whole-pose or an overlap.
     """
 
     minimum: float
@@ -94,6 +98,7 @@ class SweepResult:
     acceleration: float | None = None
     atol: float = 0.0
     seconds: float = 0.0
+    certificate: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def interferes(self) -> bool:
@@ -182,12 +187,39 @@ def _interference(distance, grid, values, lipschitz, xtol, resolution, budget):
     return merged, unresolved, evaluations
 
 
-def certified_distance(scene: SweepScene, *, lipschitz: float, acceleration: float | None = None,
+def _pair_speeds(scene, lipschitz, acceleration, instance_bounds):
+    """Per pair ``(L, A)`` arrays: each pair's two instances' bounds summed, capped by the
+    scene-wide ones when given (both are true bounds: the smaller is too)."""
+    count = len(scene.pairs)
+    speed = np.full(count, np.inf if lipschitz is None else float(lipschitz))
+    accel = None if acceleration is None and instance_bounds is None else \
+        np.full(count, np.inf if acceleration is None else float(acceleration))
+    if instance_bounds is not None:
+        missing = sorted({n for pair in scene.pairs for n in pair} - set(instance_bounds))
+        if missing:
+            raise SolidInputError("instance_bounds", f"no speed bound for instances {missing}")
+        for name, bounds in instance_bounds.items():
+            if len(bounds) != 2 or not all(math.isfinite(b) and b >= 0.0 for b in bounds):
+                raise SolidInputError("instance_bounds",
+                                      f"{name}: need (speed, acceleration) finite >= 0, "
+                                      f"not {bounds!r}")
+        own = np.array([[instance_bounds[a][k] + instance_bounds[b][k] for k in (0, 1)]
+                        for a, b in scene.pairs], dtype=float).reshape(count, 2)
+        speed = np.minimum(speed, own[:, 0])
+        accel = np.minimum(accel, own[:, 1])
+    if accel is not None and not np.all(np.isfinite(accel)):
+        accel = None
+    return speed, accel
+
+
+def certified_distance(scene: SweepScene, *, lipschitz: float | None = None,
+                       acceleration: float | None = None,
                        steps: int = 360, atol: float = 1e-6,
                        lower: float = 0.0, upper: float = 2.0 * math.pi,
                        xtol: float = INTERFERENCE_XTOL,
                        resolution: float = INTERFERENCE_RESOLUTION,
-                       max_evaluations: int = MAX_EVALUATIONS) -> SweepResult:
+                       max_evaluations: int = MAX_EVALUATIONS,
+                       instance_bounds: dict | None = None) -> SweepResult:
     """Certified least distance of the scene's groups over ``[lower, upper]``, and interference.
 
     Parameters
@@ -197,7 +229,8 @@ def certified_distance(scene: SweepScene, *, lipschitz: float, acceleration: flo
         Upper bound ``L`` (mm/rad) on ``|d distance / d phi|``: the largest
         relative speed of any point of group A against any point of group B (see
         :mod:`cadgen.sweep.scene`). The caller's responsibility: too small a
-        bound voids the certificate.
+        bound voids the certificate. May be left out when ``instance_bounds``
+        is given (then the largest pair's).
     acceleration : float, optional
         Upper bound ``A`` (mm/rad^2) on the relative acceleration of any point of
         A against any point of B. The distance is then screened to second order,
@@ -206,7 +239,8 @@ def certified_distance(scene: SweepScene, *, lipschitz: float, acceleration: flo
         splits down to intervals of ``2 atol / L`` round it, thousands of poses.
         A kink (the nearest features switching) needs only ``L``.
     steps : int
-        Intervals of the screening grid.
+        Intervals of the screening grid; its poses are evaluated exactly (the
+        distance curve of the report).
     atol : float
         The true minimum lies in ``[bound, minimum]`` and ``minimum - bound <= atol``
         when ``certified``.
@@ -221,6 +255,12 @@ def certified_distance(scene: SweepScene, *, lipschitz: float, acceleration: flo
         Budget of poses, for the minimum search and again for the interference
         scan; when spent, ``certified`` is False (or ``unresolved`` counts the
         intervals left).
+    instance_bounds : dict, optional
+        ``{instance name: (speed mm/rad, acceleration mm/rad^2)}`` bounds of any
+        point of each instance, for a scene that answers per pair (``pairs``,
+        ``lower_bounds``, ``refine``, ``exact``: :class:`cadgen.sweep.fcl.FclScene`):
+        a pair's bounds are its two instances' summed, so a slow pair is
+        certified with its own (smaller) bound.
 
     Notes
     -----
@@ -238,10 +278,19 @@ def certified_distance(scene: SweepScene, *, lipschitz: float, acceleration: flo
 
     The scan runs first: when it finds an overlap the minimum is 0, certified
     (the distance is never negative), at the first overlapping pose sampled.
+    Otherwise a scene that answers per pair is searched pair by pair
+    (:func:`cadgen.sweep.pairwise.pairwise_minimum`), any other with
+    :func:`kinematics.sweep.certified_minimum` on its whole-pose distance.
     """
+    from kinematics import tolerances as tol
     from kinematics.sweep import certified_minimum
 
-    if not (math.isfinite(lipschitz) and lipschitz >= 0.0):
+    pairwise = all(hasattr(scene, name) for name in ("pairs", "lower_bounds", "refine", "exact"))
+    if instance_bounds is not None and not pairwise:
+        raise SolidInputError("instance_bounds", "the scene does not answer pair by pair")
+    if lipschitz is None and instance_bounds is None:
+        raise SolidInputError("lipschitz", "a speed bound is needed: lipschitz or instance_bounds")
+    if lipschitz is not None and not (math.isfinite(lipschitz) and lipschitz >= 0.0):
         raise SolidInputError("lipschitz", f"must be a finite bound >= 0, not {lipschitz!r}")
     if acceleration is not None and not (math.isfinite(acceleration) and acceleration >= 0.0):
         raise SolidInputError("acceleration", f"must be a finite bound >= 0, not {acceleration!r}")
@@ -252,31 +301,57 @@ def certified_distance(scene: SweepScene, *, lipschitz: float, acceleration: flo
     if not (xtol > 0.0 and resolution >= xtol):
         raise SolidInputError("xtol",
                               f"need 0 < xtol <= resolution, got {xtol!r} and {resolution!r}")
+    if not atol > 0.0:
+        raise SolidInputError("atol", f"must be positive, not {atol!r}")
     start = time.perf_counter()
-    lipschitz = float(lipschitz)
-    curvature = None if acceleration is None else _curvature(float(acceleration), lipschitz)
-    memo = _Memo(scene)
     grid = np.linspace(lower, upper, int(steps) + 1)   # certified_minimum's screening grid
-    values = memo(grid)
-    ranges, unresolved, _ = _interference(memo, grid, values, lipschitz, xtol, resolution,
+    certificate = None
+    if pairwise:
+        from cadgen.sweep.pairwise import PairSamples, pairwise_minimum
+
+        speeds, accelerations = _pair_speeds(scene, lipschitz, acceleration, instance_bounds)
+        lipschitz = float(speeds.max())
+        if acceleration is None and accelerations is not None:
+            acceleration = float(accelerations.max())
+        samples = PairSamples(scene, lipschitz=speeds)
+        distance, evaluated = samples.distances, samples.poses
+    else:
+        memo = _Memo(scene)
+        distance, evaluated = memo, memo.values
+    lipschitz = float(lipschitz)
+    values = distance(grid)
+    ranges, unresolved, _ = _interference(distance, grid, values, lipschitz, xtol, resolution,
                                           max_evaluations)
     if ranges:
         # the distance is never negative: an overlap is the certified minimum, and
         # searching on would only split the overlap down to 2 atol / L
         minimum = bound = 0.0
-        argument = min(phi for phi, near in memo.values.items() if near.overlap)
+        if pairwise:
+            argument = min(phi for phi, pose in evaluated.items()
+                           if pose.complete and pose.nearest.overlap)
+            near = evaluated[argument].nearest
+        else:
+            argument = min(phi for phi, near in evaluated.items() if near.overlap)
+            near = memo.proximity(argument)
+    elif pairwise:
+        found = pairwise_minimum(samples, grid, lipschitz=speeds, acceleration=accelerations,
+                                 atol=atol, max_evaluations=max_evaluations,
+                                 xatol=tol.REFINE_XATOL)
+        minimum, argument, bound, near = found.value, found.argument, found.bound, found.nearest
+        certificate = found.certificate
     else:
+        curvature = None if acceleration is None else _curvature(float(acceleration), lipschitz)
         found = certified_minimum(memo, lower, upper, steps=int(steps), lipschitz=lipschitz,
                                   curvature=curvature, atol=atol, max_evaluations=max_evaluations)
         minimum, argument, bound = found.value, found.argument, max(found.bound, 0.0)
-    near = memo.proximity(argument)
+        near = memo.proximity(argument)
     return SweepResult(
         minimum=float(minimum), argument=float(argument), bound=float(bound),
-        certified=bool(minimum - bound <= atol * (1.0 + 1e-9)), evaluations=len(memo.values),
+        certified=bool(minimum - bound <= atol * (1.0 + 1e-9)), evaluations=len(evaluated),
         point_a=near.point_a, point_b=near.point_b, pair=near.pair,
         interference_ranges=ranges, unresolved=unresolved, samples_phi=grid,
         samples_distance=values, lipschitz=lipschitz, acceleration=acceleration, atol=float(atol),
-        seconds=time.perf_counter() - start)
+        seconds=time.perf_counter() - start, certificate=certificate)
 
 
 def plain_scan(scene: SweepScene, poses: int = 3600, *, lower: float = 0.0,

@@ -1,28 +1,42 @@
-"""What every figure of a report shares: an Agg figure with fixed margins, filled outlines,
-legends and event names kept off the data, PNG bytes."""
+"""What every figure of a report shares: an Agg figure laid out by measured margins, filled
+outlines, legends and event names kept off the data, PNG bytes."""
 
 from __future__ import annotations
 
-import io
+import struct
+import zlib
 
 import numpy as np
 
-__all__ = ["DPI", "_figure", "_fill", "_png", "_legend_below", "_event_ticks"]
+__all__ = ["DPI", "_figure", "_fill", "_add_patch", "_png", "_encode_png", "_legend_below",
+           "_event_ticks", "_suptitle"]
 
 #: Resolution of every figure: fine enough to print at the page's width (110 was too coarse).
 DPI = 150
+#: zlib level of the PNG files. Level 6 makes the report's sixteen figures 12 % smaller (1.56
+#: against 1.78 MB, both below the 1.92 MB Pillow's level 3 wrote) for twice the encoding time
+#: (0.15 against 0.07 s); the report is opened locally, the build is waited for.
+PNG_COMPRESSION = 3
 
 
-def _figure(width=7.5, height=5.0, **layout):
-    """A figure and its axes; ``layout`` goes to ``plt.subplots`` (``nrows=2, sharex=True``)."""
-    import matplotlib
+def _figure(width=7.5, height=5.0, **grid):
+    """A figure and its axes; ``grid`` goes to ``Figure.subplots`` (``nrows=2, sharex=True``).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    ``height`` is the figure's height, or its ceiling when every axes has an equal aspect
+    (see :func:`cadgen.report.plots.layout.fit_layout`, run by :func:`_png`). The figure is
+    not registered with pyplot: nothing global to create or close.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    # constrained layout is solved at the one draw; tight_layout would draw the figure twice
-    figure, axes = plt.subplots(figsize=(width, height), dpi=DPI, layout="constrained", **layout)
-    return figure, axes
+    figure = Figure(figsize=(width, height), dpi=DPI)
+    FigureCanvasAgg(figure)
+    return figure, figure.subplots(**grid)
+
+
+def _suptitle(figure, text: str, *, fontsize=12):
+    """A title over the whole grid (the layout keeps room for it above the axes' titles)."""
+    return figure.text(0.5, 1.0, text, ha="center", va="top", fontsize=fontsize)
 
 
 def _legend_below(figure, handles=None, labels=None, *, ncols=2, fontsize=8):
@@ -40,8 +54,10 @@ def _legend_below(figure, handles=None, labels=None, *, ncols=2, fontsize=8):
                     handles.append(handle)
                     labels.append(label)
     if handles:
-        figure.legend(handles, labels, loc="outside lower center", ncols=ncols,
-                      fontsize=fontsize, frameon=False)
+        from cadgen.report.plots.legend import foot_legend
+
+        # at the figure's foot; the layout keeps the room for it under the axes
+        foot_legend(figure, handles, labels, ncols=ncols, fontsize=fontsize, dpi=DPI)
 
 
 def _event_ticks(ax, events: dict, *, fontsize=7, rotation=0):
@@ -85,19 +101,61 @@ def _fill(ax, x, y, **style):
     return collection
 
 
-def _png(figure) -> bytes:
-    import matplotlib.pyplot as plt
+#: Settings the figures are laid out and drawn with. Text is most of a figure's drawing, and
+#: FreeType's hinting most of a glyph's cost: unhinted glyphs are drawn a quarter faster and
+#: look the same at 150 dpi.
+_DRAWING = {"text.hinting": "no_hinting"}
 
-    buffer = io.BytesIO()
-    engine = figure.get_layout_engine()
-    if engine is not None:
-        # savefig draws a figure with a layout engine twice (a pre-draw that solves the layout,
-        # then the draw); solving it here and dropping the engine draws it once, same pixels
-        engine.execute(figure)
-        figure.set_layout_engine(None)
-    # no software/date metadata, so the same design gives the same bytes; light compression
-    # (level 3 of 9) saves most of the encoding time for files a little larger
-    figure.savefig(buffer, format="png", metadata={"Software": None},
-                   pil_kwargs={"compress_level": 3})
-    plt.close(figure)
-    return buffer.getvalue()
+
+def _add_patch(ax, patch, low, high):
+    """Add a patch whose data extent (``low``, ``high`` corners) is known.
+
+    ``Axes.add_patch`` finds a patch's extent by walking its Bezier segments in Python (about
+    half a millisecond a circle); a drawing of dozens of holes and seats gives it instead.
+    """
+    ax.add_artist(patch)
+    ax.update_datalim([low, high])
+    return patch
+
+
+def _png(figure) -> bytes:
+    """Lay the figure out, draw it once and return it as PNG bytes (the same for the same
+    figure: no date or software in the file)."""
+    import matplotlib
+
+    from cadgen.report.plots.layout import fit_layout
+
+    with matplotlib.rc_context(_DRAWING):
+        fit_layout(figure, dpi=DPI)
+        figure.canvas.draw()
+    rgba = np.asarray(figure.canvas.buffer_rgba())
+    return _encode_png(rgba[:, :, :3], dpi=DPI)
+
+
+def _encode_png(rgb, *, dpi: float, level: int = PNG_COMPRESSION) -> bytes:
+    """PNG bytes of an ``(h, w, 3)`` uint8 image, every row unfiltered.
+
+    Pillow tries all five PNG filters on every row and keeps the best, which costs more than
+    the compression; a plot is mostly flat colour, which deflate packs well without a
+    filter (the files come out smaller than Pillow's at the same level). The figures are
+    opaque, so RGB: a quarter fewer bytes to compress than RGBA.
+    """
+    rgb = np.asarray(rgb, dtype=np.uint8)
+    if rgb.ndim != 3 or rgb.shape[2] != 3:
+        raise ValueError(f"expected an (h, w, 3) image, not {rgb.shape}")
+    height, width = rgb.shape[:2]
+    rows = np.empty((height, 1 + 3 * width), dtype=np.uint8)
+    rows[:, 0] = 0                                              # filter: none
+    # one strided copy straight from the canvas (the RGB of its RGBA), no intermediate
+    rows[:, 1:].reshape(height, width, 3, copy=False)[...] = rgb
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data)))
+
+    per_metre = round(dpi / 0.0254)
+    return b"".join([b"\x89PNG\r\n\x1a\n",
+                     chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)),
+                     chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+                     chunk(b"IDAT", zlib.compress(rows, level)),
+                     chunk(b"IEND", b"")])

@@ -28,7 +28,8 @@ import re
 
 import numpy as np
 
-from cadgen.report.plots.base import _figure, _fill, _legend_below, _png
+from cadgen.report.plots.base import (_add_patch, _figure, _fill, _legend_below, _png,
+                                      _suptitle)
 
 __all__ = ["housing_figure", "housing_figure_jobs", "STACK_ASPECT"]
 
@@ -47,6 +48,8 @@ _WIDTH = 9.0
 _AXIS_IN, _PARTING_IN, _DIMENSIONS_IN = 0.75, 0.9, 1.0
 #: Room (in) round the plan, for seat labels near its edge.
 _PLAN_PAD_IN = 0.15
+#: The tallest a housing's figure gets (in); below it, the height follows from the views.
+_CEILING = 12.0
 
 
 def housing_figure_jobs(housings: dict, drivetrain=None) -> dict:
@@ -95,11 +98,11 @@ def housing_figure(name: str, housing, *, shafts=None) -> bytes:
         scale = (_WIDTH - _AXIS_IN - 0.2 - margins) / max(across, s_high - s_low)
         # a seat line within about 18 deg of the page's width: one x scale for both views
         aligned = abs(direction[1 if turned else 0]) > 0.95
-        figure, (plan, cut) = _figure(_WIDTH, 6.0, nrows=2, sharex=aligned)
+        figure, (plan, cut) = _figure(_WIDTH, _CEILING, nrows=2, sharex=aligned)
         plan.tick_params(labelbottom=True)
     else:
         scale = (_WIDTH - 2 * _AXIS_IN - 0.3 - margins) / (across + s_high - s_low)
-        figure, (plan, cut) = _figure(_WIDTH, 6.0, ncols=2)
+        figure, (plan, cut) = _figure(_WIDTH, _CEILING, ncols=2)
     _draw_plan(plan, housing, turned=turned, line=(centre, direction, section["extent"]),
                scale=scale)
     _draw_section(cut, housing, section, shafts=shafts, scale=scale, narrow=not stacked)
@@ -108,48 +111,48 @@ def housing_figure(name: str, housing, *, shafts=None) -> bytes:
     plan.update_datalim([box[:2] - pad, box[2:] + pad])
     cut.update_datalim([(s_low - _PARTING_IN / scale, housing.z_bottom),
                         (s_high + _DIMENSIONS_IN / scale, housing.z_top)])
-    _fit(figure, plan, cut, stacked, _legend_rows(housing, shafts))
     for ax in (plan, cut):
-        # equal scales; the data limits (not fixed limits) let the aspect widen the free
-        # direction quietly (the heights, when the x axes are shared). Beside a plan, the
-        # short section's frame shrinks to the drawing instead of framing empty space.
         ax.margins(0)
         ax.autoscale_view()
-        ax.set_aspect("equal", adjustable="box" if ax is cut and not stacked else "datalim")
+        ax.set_aspect("equal", adjustable="box")
         ax.tick_params(labelsize=_FONT)
+    _one_scale(plan, cut, stacked)
     if turned:
         plan.invert_yaxis()   # up is -x: the plan turned, not mirrored (still seen from above)
-    figure.suptitle(f"{name}: base and cover, {len(housing.bolt_positions)} x "
-                    f"{housing.bolt_size} bolts", fontsize=10)
+    _suptitle(figure, f"{name}: base and cover, {len(housing.bolt_positions)} x "
+                      f"{housing.bolt_size} bolts", fontsize=10)
     _legend_below(figure, ncols=4, fontsize=_FONT)
     return _png(figure)
 
 
-def _fit(figure, plan, cut, stacked, legend_rows) -> None:
-    """Size the figure and its grid to the views' data extents at one scale, so that neither
-    view is squeezed (with shared x, a short slot would crop the heights) nor lost in white."""
-    (p_x0, p_y0), (p_x1, p_y1) = plan.dataLim.get_points()
-    (c_x0, c_y0), (c_x1, c_y1) = cut.dataLim.get_points()
-    decorations = 1.2 + 0.16 * legend_rows      # titles, tick and axis labels, the legend (in)
-    slack = 1.04                                # the layout's estimates are not exact
+def _one_scale(plan, cut, stacked) -> None:
+    """Give both views one scale: the layout makes each equal-aspect view as wide as its
+    column, so stacked views get x ranges of one length (the longer one's, each centred on
+    its own drawing unless the axes are shared) and side-by-side columns are as wide as
+    their drawings."""
+    spans = [abs(np.subtract(*ax.get_xlim())) for ax in (plan, cut)]
     grid = plan.get_subplotspec().get_gridspec()
-    if stacked:
-        scale = (_WIDTH - _AXIS_IN - 0.2) / (max(p_x1, c_x1) - min(p_x0, c_x0))
-        heights = [(p_y1 - p_y0) * scale * slack, (c_y1 - c_y0) * scale * slack]
-        grid.set_height_ratios(heights)
-        figure.set_size_inches(_WIDTH, sum(heights) + decorations + 0.5)   # two rows of labels
-    else:
-        widths = [p_x1 - p_x0, c_x1 - c_x0]
-        scale = (_WIDTH - 2 * _AXIS_IN - 0.3) / sum(widths)
-        grid.set_width_ratios(widths)
-        figure.set_size_inches(_WIDTH, max(p_y1 - p_y0, c_y1 - c_y0) * scale * slack
-                               + decorations)
+    if not stacked:
+        grid.set_width_ratios(spans)
+        return
+    if plan.get_shared_x_axes().joined(plan, cut):
+        return
+    for ax in (plan, cut):
+        middle = float(np.mean(ax.get_xlim()))
+        ax.set_xlim(middle - max(spans) / 2, middle + max(spans) / 2)
 
 
-def _legend_rows(housing, shafts) -> int:
-    """Rows of the figure's legend (four entries a row): the height it needs."""
-    entries = 8 + any(seat.through for seat in housing.seats) + (shafts is not None)
-    return -(-entries // 4)
+def _circle(ax, centre, radius, **style):
+    from matplotlib.patches import Circle
+
+    return _add_patch(ax, Circle(centre, radius, **style), np.subtract(centre, radius),
+                      np.add(centre, radius))
+
+
+def _rectangle(ax, low, high, **style):
+    from matplotlib.patches import Rectangle
+
+    return _add_patch(ax, Rectangle(low, high[0] - low[0], high[1] - low[1], **style), low, high)
 
 
 def _mm(value: float) -> str:
@@ -283,7 +286,6 @@ def _draw_plan(ax, housing, *, turned=False, line=None, scale=None) -> dict:
         ``bolt_holes``, ``seats``, ``through_holes`` (matplotlib patches) and ``labels``
         (texts), one per bolt, per seat circle, per through hole, per seat position.
     """
-    from matplotlib.patches import Circle
 
     def view(points):
         points = np.asarray(points, dtype=float).reshape(-1, 2)
@@ -303,9 +305,9 @@ def _draw_plan(ax, housing, *, turned=False, line=None, scale=None) -> dict:
                   f"{housing.bolt_size})")
     for index, xy in enumerate(np.asarray(housing.bolt_positions, dtype=float)):
         h, v = view(xy)
-        drawn["bolt_holes"].append(ax.add_patch(Circle(
-            (h[0], v[0]), radius, facecolor="white", edgecolor="k", linewidth=0.6, zorder=3,
-            label=bolt_label if index == 0 else None)))
+        drawn["bolt_holes"].append(_circle(
+            ax, (h[0], v[0]), radius, facecolor="white", edgecolor="k", linewidth=0.6, zorder=3,
+            label=bolt_label if index == 0 else None))
     groups: dict = {}     # one label per seat position: a floor and a roof seat share it
     for seat in housing.seats:
         groups.setdefault(tuple(np.round(np.asarray(seat.xy, dtype=float), 6)), []).append(seat)
@@ -316,15 +318,15 @@ def _draw_plan(ax, housing, *, turned=False, line=None, scale=None) -> dict:
             key = (position, round(float(seat.seat_diameter), 6))
             if key not in drawn_circles:
                 drawn_circles.add(key)
-                drawn["seats"].append(ax.add_patch(Circle(
-                    (h, v), float(seat.seat_diameter) / 2, facecolor=_SEAT_FILL,
+                drawn["seats"].append(_circle(
+                    ax, (h, v), float(seat.seat_diameter) / 2, facecolor=_SEAT_FILL,
                     edgecolor=_SEAT, linewidth=1.0, zorder=3,
-                    label=None if drawn["seats"] else "bearing seat (seat bore)")))
+                    label=None if drawn["seats"] else "bearing seat (seat bore)"))
             if seat.through:
-                drawn["through_holes"].append(ax.add_patch(Circle(
-                    (h, v), float(seat.hole_diameter) / 2, facecolor=_HOLE, edgecolor="k",
+                drawn["through_holes"].append(_circle(
+                    ax, (h, v), float(seat.hole_diameter) / 2, facecolor=_HOLE, edgecolor="k",
                     linewidth=0.6, zorder=4,
-                    label=None if drawn["through_holes"] else "through hole (shaft leaves)")))
+                    label=None if drawn["through_holes"] else "through hole (shaft leaves)"))
         ax.plot([h], [v], "+", color="k", ms=4, mew=0.6, zorder=5)
     drawn["labels"] = _seat_labels(ax, groups, view, up, scale)
     if line is not None:
@@ -369,8 +371,6 @@ def _draw_section(ax, housing, section, *, shafts=None, scale=1.0, narrow=False)
     """Draw the section (``_section``'s output) on ``ax``: halves, seats, shafts, parting
     plane, shaft names above and the end walls' and the cavity's dimensions on the right
     (``scale`` in per mm, for the labels' room; ``narrow``: the title on two lines)."""
-    from matplotlib.patches import Rectangle
-
     for geometry, colour, hatch, label in ((section["base"], _BASE, "///", "base (section)"),
                                            (section["cover"], _COVER, "\\\\\\",
                                             "cover (section)")):
@@ -388,11 +388,11 @@ def _draw_section(ax, housing, section, *, shafts=None, scale=1.0, narrow=False)
     axes_of: dict = {}
     for seat, s, (s0, s1), (z0, z1), hole in section["seats"]:
         axes_of.setdefault(round(s, 6), []).append((seat, z0, z1, hole))
-        ax.add_patch(Rectangle((s0, z0), s1 - s0, z1 - z0, facecolor=_SEAT_FILL, edgecolor=_SEAT,
-                               linewidth=0.9, zorder=4))
+        _rectangle(ax, (s0, z0), (s1, z1), facecolor=_SEAT_FILL, edgecolor=_SEAT, linewidth=0.9,
+                   zorder=4)
         if hole is not None:
-            ax.add_patch(Rectangle((hole[0], hole[2]), hole[1] - hole[0], hole[3] - hole[2],
-                                   facecolor="none", edgecolor=_HOLE, linewidth=0.7, zorder=4))
+            _rectangle(ax, (hole[0], hole[2]), (hole[1], hole[3]), facecolor="none",
+                       edgecolor=_HOLE, linewidth=0.7, zorder=4)
     over = 0.08 / scale
     spans, shaft_label = {}, "shaft"
     for s, seats in axes_of.items():
@@ -408,8 +408,8 @@ def _draw_section(ax, housing, section, *, shafts=None, scale=1.0, narrow=False)
         high = max([z_top + diameter / 2 if hole else z1
                     for seat, _, z1, hole in seats if seat.wall == "roof"]
                    or [housing.z_cavity_bottom + housing.cavity_height])
-        ax.add_patch(Rectangle((s - diameter / 2, low), diameter, high - low, facecolor=_SHAFT,
-                               edgecolor="0.35", linewidth=0.6, zorder=3.5, label=shaft_label))
+        _rectangle(ax, (s - diameter / 2, low), (s + diameter / 2, high), facecolor=_SHAFT,
+                   edgecolor="0.35", linewidth=0.6, zorder=3.5, label=shaft_label)
         shaft_label = None     # one legend entry for all the shafts
         spans[s] = (min(low, z_bottom) - over, max(high, z_top) + over)
     # the shaft names in one row above the section and whatever sticks out of it

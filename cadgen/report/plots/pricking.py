@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cadgen.report.plots.base import _figure, _legend_below, _png
+from cadgen.report.plots.base import _figure, _legend_below, _png, _suptitle
 from kinematics.planar import unit as _unit
 
 __all__ = ["pricking_figures"]
@@ -59,7 +59,7 @@ def loop(design):
 
 
 def pitch_curves(design):
-    # constrained layout keeps each title clear of the tick labels of the plot above
+    # the layout keeps each title clear of the tick labels of the plot above
     figure, axes = _figure(9.0, 8.5, nrows=2, ncols=2)
     for ax, gear in zip(axes.ravel(), design.gears):
         radius, angle = gear.table["radius"], gear.table["body_angle"]
@@ -80,8 +80,9 @@ def pitch_curves(design):
         ax.set_aspect("equal")
         ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3)
-    figure.suptitle(f"Pitch curves: teeth {design.teeth[0]} / {design.teeth[1]}, modules "
-                    f"{design.modules[0]:.3f} / {design.modules[1]:.3f} mm, scale {design.scale:.4f}")
+    _suptitle(figure, f"Pitch curves: teeth {design.teeth[0]} / {design.teeth[1]}, modules "
+                      f"{design.modules[0]:.3f} / {design.modules[1]:.3f} mm, "
+                      f"scale {design.scale:.4f}")
     return _png(figure)
 
 

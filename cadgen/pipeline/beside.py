@@ -1,0 +1,194 @@
+"""The worker forked beside the teeth: the sweeps on a gearless assembly, and the figures that
+show no gear, while the building process cuts the gears.
+
+On a machine with a second core and the fork start method, :func:`start_beside` forks one
+worker when the teeth stage begins. The worker inherits every value computed so far (nothing
+is pickled on the way in), builds the gearless parts, runs the FCL sweeps on them (only where
+the swept parts do not depend on the gears: :data:`GEARLESS_SWEEPS`), then draws every
+figure that shows no gear; its results come back pickled (sweep records and values, PNG
+bytes). The building process cuts the teeth, builds the parts with the gears, draws the
+figures that show gears (:func:`plots_beside`) and then collects the worker's
+(:func:`collect`). What is computed is the same either way, file for file
+(tests/test_beside.py); its progress events are relayed through a pipe
+(:class:`cadgen.pipeline.progress.StageProgress`), marked ``beside``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from cadgen.pipeline.build import (STAGE_NEEDS, SWEEP_STAGES, StageRecord, _gearless_parts,
+                                   _run_stage)
+
+__all__ = ["GEARLESS_SWEEPS", "start_beside", "collect", "plots_beside"]
+
+#: Mechanisms whose parts other than gears and shafts do not depend on the gears, so that a
+#: sweep of the gearless assembly is the sweep of the one written (the shafts' spin is bounded
+#: by the sweep whatever their keyseats' angle). Not the pricking mechanism: its gear case is
+#: drawn round the gears' own outlines (the gearless one is larger), so its sweep waits for them.
+GEARLESS_SWEEPS = frozenset({"planting"})
+_BESIDE: dict = {}
+
+
+@dataclass
+class _Beside:
+    """The forked worker's future and the sweep stages it runs."""
+
+    future: object
+    sweeps: tuple
+
+
+def _shows_gears(figure: str) -> bool:
+    """A figure drawn in the building process: it shows the gears, cut after the fork."""
+    return figure == "assembly.png" or figure.startswith("gears-")
+
+
+def start_beside(run, functions):
+    """Fork the worker beside the teeth (sweeps and gearless figures), or None: nothing for it
+    to do, no second core, no fork, or a failed stage before."""
+    import multiprocessing
+
+    from cadgen.pipeline.figures import _can_fork
+
+    sweeps = tuple(s for s in SWEEP_STAGES if s in run.stages
+                   and run.params.mechanism in GEARLESS_SWEEPS)
+    figures = "plots" in run.stages
+    if not (sweeps or figures) or "teeth" not in run.stages or not _can_fork() \
+            or any(r.status != "ok" for r in run.records):
+        return None
+    from concurrent.futures import ProcessPoolExecutor
+
+    # what both processes need, imported once before the fork: this process needs it anyway
+    # (its parts, its gear figures), so only the worker's time is saved
+    if "parts" in run.stages:
+        import importlib
+
+        importlib.import_module("trimesh")   # a third of a second (scipy.spatial, networkx)
+    if figures:
+        from cadgen.pipeline.figures import preload
+
+        preload()
+    ends = run.progress.pipe()
+    _BESIDE.update(run=run, functions=functions, sweeps=sweeps, figures=figures,
+                   events=ends[1] if ends else None)
+    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
+    try:
+        future = pool.submit(_beside)   # forks the worker here
+    finally:
+        _BESIDE.clear()             # the forked worker has its own copy
+        if ends:
+            run.progress.relay(ends[0])
+            ends[1].close()         # the worker's copy is the last: its end is the relay's
+    pool.shutdown(wait=False)   # the worker ends after its one task
+    return _Beside(future, sweeps)
+
+
+def _beside() -> dict:
+    """In the forked worker: the gearless parts, each sweep, then the figures that show no gear.
+
+    ``{"stages": {stage: (record, value)}, "figures": {name: PNG bytes}, "seconds": float}``.
+    """
+    run, functions, sweeps = _BESIDE["run"], _BESIDE["functions"], _BESIDE["sweeps"]
+    events, progress = _BESIDE.get("events"), run.progress
+    if events is not None:
+        progress.forward(events)
+    try:
+        out = {}
+        parts_record = None
+        if sweeps:
+            progress.started("parts", detail="without gears, for the sweeps", beside=True)
+            parts_record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
+            progress.finished("parts", parts_record.status, parts_record.seconds,
+                              detail=parts_record.message or "without gears, for the sweeps",
+                              beside=True)
+            if parts_record.status == "ok":
+                run.values["parts"] = parts
+                run.records.append(parts_record)
+        for stage in sweeps:
+            if parts_record.status != "ok":
+                record = StageRecord(stage, "skipped",
+                                     message="needs parts, which did not complete")
+                progress.finished(stage, "skipped", 0.0, detail=record.message, beside=True)
+                out[stage] = (record, None)
+                continue
+            progress.started(stage, beside=True)
+            record, value = _run_stage(run, stage, functions)
+            record.message = record.message or "ran beside the teeth, in a second process"
+            progress.finished(stage, record.status, record.seconds, detail=record.message,
+                              beside=True)
+            out[stage] = (record, value)
+            run.records.append(record)
+            if record.status == "ok":
+                run.values[stage] = value
+        figures, start = {}, time.perf_counter()
+        if "plots" in run.stages:
+            from cadgen.pipeline.figures import figure_jobs
+
+            jobs = {name: draw for name, draw in figure_jobs(run).items()
+                    if not _shows_gears(name)}
+            progress.started("plots", steps=len(jobs), detail="figures without gears",
+                             beside=True)
+            for name, draw in jobs.items():
+                figures[name] = draw()
+                progress.step("plots", name, beside=True)
+            progress.finished("plots", "ok", time.perf_counter() - start,
+                              detail="figures without gears", beside=True)
+        return {"stages": out, "figures": figures, "seconds": time.perf_counter() - start}
+    finally:
+        if events is not None:
+            events.close()          # the relay's end of file
+
+
+def collect(run, beside) -> dict:
+    """The worker's results: its sweep stages recorded here (as if run here), its figures."""
+    outcome = beside.future.result()
+    run.progress.join()         # the worker's events, all delivered
+    for stage in beside.sweeps:
+        failed = [need for need in STAGE_NEEDS[stage] if run.status(need) != "ok"]
+        if failed:
+            record, value = StageRecord(stage, "skipped", message=(
+                f"needs {', '.join(failed)}, which did not complete")), None
+        else:
+            record, value = outcome["stages"][stage]
+        if stage not in run.progress.finished_stages():   # the worker said nothing
+            run.progress.finished(stage, record.status, record.seconds,
+                                  detail=record.message, beside=True)
+        run.records.append(record)
+        if record.status == "ok":
+            run.values[stage] = value
+    return outcome
+
+
+def plots_beside(run, beside):
+    """Stage ``plots`` with the worker: draw the figures that show gears here, then take the
+    worker's (and its sweeps); one record, the two processes' drawing times added."""
+    from cadgen.pipeline.figures import figure_jobs
+
+    jobs = {name: draw for name, draw in figure_jobs(run).items() if _shows_gears(name)}
+    run.progress.started("plots", steps=len(jobs))
+    start = time.perf_counter()
+    mine = {}
+    for name, draw in jobs.items():
+        mine[name] = draw()
+        run.progress.step("plots", name)
+    seconds = time.perf_counter() - start
+    outcome = collect(run, beside)
+    theirs = outcome["figures"]
+    order = list(figure_jobs(run))     # now with the sweeps' figure
+    # any figure the worker could not draw (its gearless parts failed): drawn here
+    for name, draw in figure_jobs(run).items():
+        if name not in mine and name not in theirs:
+            begun = time.perf_counter()
+            mine[name] = draw()
+            seconds += time.perf_counter() - begun
+            run.progress.step("plots", name)
+    figures = {**mine, **theirs}
+    run.figures = {name: figures[name] for name in order if name in figures}
+    # the stage's time: both processes' drawing (the work), each said in the message
+    record = StageRecord("plots", "ok", seconds + outcome["seconds"],
+                         f"{len(theirs)} of {len(run.figures)} figures drawn beside the teeth, "
+                         f"in a second process ({seconds:.2f} s here, "
+                         f"{outcome['seconds']:.2f} s there)")
+    run.progress.finished("plots", "ok", record.seconds, detail=record.message)
+    return record, run.figures
