@@ -47,6 +47,7 @@ from cadgen.export.atomic import write_bytes_atomic
 from cadgen.solids.errors import ExportFormatError, SolidInputError
 
 __all__ = [
+    "solids_files",
     "AssemblyFormat",
     "GLTF_METRES_PER_MM",
     "CREASE_ANGLE_DEG",
@@ -411,12 +412,22 @@ def write_solids(outcome, staging) -> list:
     folder = staging / "solids"
     folder.mkdir()
     written = []
-    for part in outcome.assembly.parts:
-        (folder / f"{part.name}.stl").write_bytes(stl_bytes(outcome.printing_mesh(part)))
-        written.append(f"solids/{part.name}.stl")
-    placed = [(name, part.mesh, pose, part.kind) for name, part, pose
-              in outcome.assembly.placements(outcome.carrier_angle)]
-    (folder / f"assembly.{outcome.file_type}").write_bytes(
-        assembly_bytes(placed, outcome.file_type))
-    written.append(f"solids/assembly.{outcome.file_type}")
+    for name, data in solids_files(outcome):
+        (folder / name).write_bytes(data)
+        written.append(f"solids/{name}")
     return written
+
+
+def solids_files(outcome):
+    """``(file name, bytes)`` of each file :func:`write_solids` writes, each made once per
+    outcome (:meth:`~cadgen.solids.outcome.SolidsOutcome.once`), as it is asked for."""
+    for part in outcome.assembly.parts:
+        yield f"{part.name}.stl", outcome.once(("stl", part.name),
+                                               lambda: stl_bytes(outcome.printing_mesh(part)))
+
+    def assembly():
+        placed = [(name, part.mesh, pose, part.kind) for name, part, pose
+                  in outcome.assembly.placements(outcome.carrier_angle)]
+        return assembly_bytes(placed, outcome.file_type)
+
+    yield f"assembly.{outcome.file_type}", outcome.once("assembly", assembly)

@@ -31,12 +31,25 @@ GEARLESS_SWEEPS = frozenset({"planting"})
 _BESIDE: dict = {}
 
 
+#: Part kinds the gearless assembly shares with the one built with the gears (planting): the
+#: worker's meshes of these, made for the sweeps, are the building process's too. Not the
+#: gears, not the shafts (their keyseats turn to the gears' keyways).
+SHARED_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground"})
+
+
 @dataclass
 class _Beside:
-    """The forked worker's future and the sweep stages it runs."""
+    """The forked worker's two tasks (its solids and sweeps, then its figures) and the sweep
+    stages it runs."""
 
-    future: object
+    solids: object          # future: {"stages": ..., "meshes": {name: (vertices, faces)}}
+    figures: object         # future: {"figures": ..., "seconds": ...}
     sweeps: tuple
+
+    @property
+    def future(self):
+        """The last task: done when the worker is."""
+        return self.figures
 
 
 def _shows_gears(figure: str) -> bool:
@@ -74,20 +87,22 @@ def start_beside(run, functions):
                    events=ends[1] if ends else None)
     pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
     try:
-        future = pool.submit(_beside)   # forks the worker here
+        solids = pool.submit(_beside_solids)   # forks the worker here
+        figures = pool.submit(_beside_figures)  # the same worker, after the first task
     finally:
         _BESIDE.clear()             # the forked worker has its own copy
         if ends:
             run.progress.relay(ends[0])
             ends[1].close()         # the worker's copy is the last: its end is the relay's
-    pool.shutdown(wait=False)   # the worker ends after its one task
-    return _Beside(future, sweeps)
+    pool.shutdown(wait=False)   # the worker ends after its two tasks
+    return _Beside(solids, figures, sweeps)
 
 
-def _beside() -> dict:
-    """In the forked worker: the gearless parts, each sweep, then the figures that show no gear.
+def _beside_solids() -> dict:
+    """In the forked worker, first: the gearless parts and each sweep.
 
-    ``{"stages": {stage: (record, value)}, "figures": {name: PNG bytes}, "seconds": float}``.
+    ``{"stages": {stage: (record, value)}, "meshes": {part name: (vertices, faces)}}``: the
+    meshes of the parts of :data:`SHARED_KINDS` that the sweeps made.
     """
     run, functions, sweeps = _BESIDE["run"], _BESIDE["functions"], _BESIDE["sweeps"]
     events, progress = _BESIDE.get("events"), run.progress
@@ -121,6 +136,28 @@ def _beside() -> dict:
             run.records.append(record)
             if record.status == "ok":
                 run.values[stage] = value
+        meshes = {}
+        if parts_record is not None and parts_record.status == "ok":
+            meshes = {part.name: (part._mesh.vertices, part._mesh.faces)
+                      for part in run.values["parts"].assembly.parts
+                      if part.kind in SHARED_KINDS and part._mesh is not None}
+        return {"stages": out, "meshes": meshes}
+    except BaseException:
+        if events is not None:
+            events.close()          # no second task will: the relay's end of file
+        _BESIDE["failed"] = True
+        raise
+
+
+def _beside_figures() -> dict:
+    """In the forked worker, second: the figures that show no gear.
+
+    ``{"figures": {name: PNG bytes}, "seconds": float}``.
+    """
+    run, events, progress = _BESIDE["run"], _BESIDE.get("events"), _BESIDE["run"].progress
+    if _BESIDE.get("failed"):
+        return {"figures": {}, "seconds": 0.0}
+    try:
         figures, start = {}, time.perf_counter()
         if "plots" in run.stages:
             from cadgen.pipeline.figures import figure_jobs
@@ -134,16 +171,37 @@ def _beside() -> dict:
                 progress.step("plots", name, beside=True)
             progress.finished("plots", "ok", time.perf_counter() - start,
                               detail="figures without gears", beside=True)
-        return {"stages": out, "figures": figures, "seconds": time.perf_counter() - start}
+        return {"figures": figures, "seconds": time.perf_counter() - start}
     finally:
         if events is not None:
             events.close()          # the relay's end of file
 
 
+def take_meshes(run, beside) -> int:
+    """Give this build's parts the worker's meshes of the same parts (:data:`SHARED_KINDS`)
+    where it made them and this process has not yet: the same triangles, not made twice.
+    Returns how many were taken (none before the worker's first task is done)."""
+    if not beside.solids.done() or run.status("parts") != "ok":
+        return 0
+    import trimesh
+
+    meshes = beside.solids.result()["meshes"]
+    taken = 0
+    for part in run.values["parts"].assembly.parts:
+        if part.kind in SHARED_KINDS and part._mesh is None and part.name in meshes:
+            vertices, faces = meshes[part.name]
+            # as cadgen.solids.extrude.to_trimesh made it in the worker (checked there)
+            part._mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False,
+                                         metadata={"name": part.name})
+            taken += 1
+    return taken
+
+
 def collect(run, beside) -> dict:
     """The worker's results: its sweep stages recorded here (as if run here), its figures."""
-    outcome = beside.future.result()
+    outcome = {**beside.solids.result(), **beside.figures.result()}
     run.progress.join()         # the worker's events, all delivered
+    take_meshes(run, beside)
     for stage in beside.sweeps:
         failed = [need for need in STAGE_NEEDS[stage] if run.status(need) != "ok"]
         if failed:
@@ -168,11 +226,16 @@ def plots_beside(run, beside):
     jobs = {name: draw for name, draw in figure_jobs(run).items() if _shows_gears(name)}
     run.progress.started("plots", steps=len(jobs))
     start = time.perf_counter()
+    take_meshes(run, beside)    # the assembly view meshes every part: the worker's, if made
     mine = {}
     for name, draw in jobs.items():
         mine[name] = draw()
         run.progress.step("plots", name)
     seconds = time.perf_counter() - start
+    if not beside.future.done():   # while the worker finishes: what the writing will need
+        from cadgen.pipeline.writers import prepare
+
+        prepare(run, beside.future.done)
     outcome = collect(run, beside)
     theirs = outcome["figures"]
     order = list(figure_jobs(run))     # now with the sweeps' figure

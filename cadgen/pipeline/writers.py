@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["writers_for"]
+__all__ = ["writers_for", "prepare"]
 
 
 def writers_for(run) -> list:
@@ -34,6 +34,30 @@ def writers_for(run) -> list:
     if "parts" in ok and run.report.get("bom"):
         writers.append(lambda staging: _write_bom(run, staging))
     return writers
+
+
+def prepare(run, until) -> int:
+    """Make what the writing and the report will need, one piece at a time, until ``until()``
+    says stop (the worker beside has finished): the solids' report section, each STL, the
+    assembly file. Made once, they are taken as made later (same bytes). Returns the pieces made.
+    """
+    if run.status("parts") != "ok":
+        return 0
+    from cadgen.export.meshes import solids_files
+    from cadgen.solids.outcome import solids_report
+
+    outcome = run.values["parts"]
+    made = 0
+    if until():
+        return made
+    solids_report(outcome)
+    made += 1
+    if "stl" in run.effects:
+        for _ in solids_files(outcome):
+            made += 1
+            if until():
+                break
+    return made
 
 
 def _write_bom(run, staging):

@@ -45,6 +45,14 @@ class SolidsOutcome:
     build_volume: tuple = DEFAULT_BUILD_VOLUME   # mm (x, y, z), the printer's
     process: str = "machined"                    # [manufacturing] process: parts' materials
     _poses: dict = field(default_factory=dict, repr=False)
+    _made: dict = field(default_factory=dict, repr=False)   # what once() computed, by key
+
+    def once(self, key, compute):
+        """``compute()``, computed once per key (the STL bytes, the assembly file, the report
+        section): a build prepares them while it waits for its worker, then writes them."""
+        if key not in self._made:
+            self._made[key] = compute()
+        return self._made[key]
 
     def printing_pose(self, part) -> np.ndarray:
         """The part's printing pose (see :func:`printing_pose`), computed once per part."""
@@ -234,7 +242,14 @@ def enclosure_checks(assembly, housings: dict) -> list:
 
 
 def solids_report(outcome: SolidsOutcome) -> dict:
-    """Mass properties per part, the enclosure checks and the assembly's pose (report.json)."""
+    """Mass properties per part, the enclosure checks and the assembly's pose (report.json);
+    computed once per outcome (a copy each call)."""
+    import copy
+
+    return copy.deepcopy(outcome.once("report", lambda: _solids_report(outcome)))
+
+
+def _solids_report(outcome: SolidsOutcome) -> dict:
     from cadgen.machine.fits import process_fits
     from cadgen.solids.mass import mass_properties
 
