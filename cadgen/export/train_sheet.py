@@ -24,7 +24,7 @@ from cadgen.export.dxf import (CENTRE_MARK_HALF_LENGTH_MODULES, LABEL_GAP_MODULE
                                _text_box, _thin_gear, gear_dxf_bytes, writer_fingerprint)
 from cadgen.geometry.contour import closed_points, ring_measures
 
-__all__ = ["write_train_sheet", "write_train_files"]
+__all__ = ["write_train_sheet", "write_train_files", "train_files"]
 
 
 def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: float = 0.005,
@@ -247,6 +247,17 @@ def write_train_files(train, folder, chord_tolerance: float, cache=None) -> list
     decides them (:func:`cadgen.gears.cache.file_key`) and stored once made: a warm build
     writes the same bytes without making them.
     """
+    folder = Path(folder)
+    written = []
+    for name, data in train_files(train, chord_tolerance, cache, folder=folder):
+        write_bytes_atomic(folder / name, data)
+        written.append(folder / name)
+    return written
+
+
+def train_files(train, chord_tolerance: float, cache=None, *, folder=Path(".")) -> list:
+    """``[(file name, bytes)]`` of what :func:`write_train_files` writes (``folder`` only names
+    the files in error messages)."""
     from cadgen.gears.trains import _placements
 
     cache = cache if cache is not None else getattr(train, "cache", None)
@@ -256,13 +267,12 @@ def write_train_files(train, folder, chord_tolerance: float, cache=None) -> list
     placements = _placements(train)
     planes = _mesh_planes(train, [profile.name for profile, _, _ in placements])
     files = _CachedFiles(cache, tolerance)
-    written = []
+    made = []
     for profile in profiles:
         path = folder / f"{profile.file_stem}.dxf"
-        write_bytes_atomic(path, files.get(("gear dxf", profile), lambda profile=profile, path=path:
-                                           gear_dxf_bytes(profile, *_cut(profile, tolerance)[::2],
-                                                          path=path)))
-        written.append(path)
+        made.append((path.name, files.get(("gear dxf", profile), lambda profile=profile, path=path:
+                                          gear_dxf_bytes(profile, *_cut(profile, tolerance)[::2],
+                                                         path=path))))
     sheet = folder / "train.dxf"
 
     def make_sheet():
@@ -270,9 +280,8 @@ def write_train_files(train, folder, chord_tolerance: float, cache=None) -> list
         return _sheet_bytes(sheet, placements, checked, LABEL_HEIGHT,
                             lambda profile: _cut(profile, tolerance))[0]
 
-    write_bytes_atomic(sheet, files.get(("train sheet", placements, planes), make_sheet))
-    written.append(sheet)
-    return written
+    made.append((sheet.name, files.get(("train sheet", placements, planes), make_sheet)))
+    return made
 
 
 def _cut(profile, tolerance: float):

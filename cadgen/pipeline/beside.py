@@ -39,21 +39,31 @@ SHARED_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground"})
 
 @dataclass
 class _Beside:
-    """The forked worker's two tasks (its solids and sweeps, then its figures) and the sweep
-    stages it runs."""
+    """The forked worker's tasks (its solids and sweeps, its figures, then the gear pairs'
+    figures from data sent after the teeth) and the sweep stages it runs."""
 
+    pool: object
     solids: object          # future: {"stages": ..., "meshes": {name: (vertices, faces)}}
     figures: object         # future: {"figures": ..., "seconds": ...}
     sweeps: tuple
+    taken: object           # shared counter: the next gear pair's figure to draw, either side
+    pairs: object = None    # future of the last task: {"figures": ..., "seconds": ...}
 
-    @property
-    def future(self):
-        """The last task: done when the worker is."""
-        return self.figures
+    def finish(self, pairs: dict | None = None):
+        """Send the last task (the pairs' figures to draw, or none): it closes the worker's
+        progress pipe, and the worker ends after it."""
+        if self.pairs is None:
+            self.pairs = self.pool.submit(_beside_pairs, pairs or {})
+            self.pool.shutdown(wait=False)
+        return self.pairs
+
+    def done(self) -> bool:
+        return self.pairs is not None and self.pairs.done()
 
 
 def _shows_gears(figure: str) -> bool:
-    """A figure drawn in the building process: it shows the gears, cut after the fork."""
+    """A figure that shows the gears, cut after the fork: the gear pairs' are drawn by the
+    worker from data sent to it; the assembly view, which needs every part's mesh, here."""
     return figure == "assembly.png" or figure.startswith("gears-")
 
 
@@ -83,8 +93,9 @@ def start_beside(run, functions):
 
         preload()
     ends = run.progress.pipe()
+    taken = multiprocessing.get_context("fork").Value("i", 0)
     _BESIDE.update(run=run, functions=functions, sweeps=sweeps, figures=figures,
-                   events=ends[1] if ends else None)
+                   events=ends[1] if ends else None, taken=taken)
     pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
     try:
         solids = pool.submit(_beside_solids)   # forks the worker here
@@ -94,8 +105,7 @@ def start_beside(run, functions):
         if ends:
             run.progress.relay(ends[0])
             ends[1].close()         # the worker's copy is the last: its end is the relay's
-    pool.shutdown(wait=False)   # the worker ends after its two tasks
-    return _Beside(solids, figures, sweeps)
+    return _Beside(pool, solids, figures, sweeps, taken)
 
 
 def _beside_solids() -> dict:
@@ -143,9 +153,7 @@ def _beside_solids() -> dict:
                       if part.kind in SHARED_KINDS and part._mesh is not None}
         return {"stages": out, "meshes": meshes}
     except BaseException:
-        if events is not None:
-            events.close()          # no second task will: the relay's end of file
-        _BESIDE["failed"] = True
+        _BESIDE["failed"] = True    # the next tasks draw nothing
         raise
 
 
@@ -154,7 +162,7 @@ def _beside_figures() -> dict:
 
     ``{"figures": {name: PNG bytes}, "seconds": float}``.
     """
-    run, events, progress = _BESIDE["run"], _BESIDE.get("events"), _BESIDE["run"].progress
+    run, progress = _BESIDE["run"], _BESIDE["run"].progress
     if _BESIDE.get("failed"):
         return {"figures": {}, "seconds": 0.0}
     try:
@@ -164,13 +172,36 @@ def _beside_figures() -> dict:
 
             jobs = {name: draw for name, draw in figure_jobs(run).items()
                     if not _shows_gears(name)}
-            progress.started("plots", steps=len(jobs), detail="figures without gears",
-                             beside=True)
+            progress.started("plots", steps=len(jobs), detail="figures", beside=True)
             for name, draw in jobs.items():
                 figures[name] = draw()
                 progress.step("plots", name, beside=True)
-            progress.finished("plots", "ok", time.perf_counter() - start,
-                              detail="figures without gears", beside=True)
+        _BESIDE["drawn"] = (len(figures), time.perf_counter() - start)
+        return {"figures": figures, "seconds": time.perf_counter() - start}
+    except BaseException:
+        _BESIDE["failed"] = True
+        raise
+
+
+def _beside_pairs(pairs: dict) -> dict:
+    """In the forked worker, last: the gear pairs' figures from their data
+    (:func:`cadgen.report.plots.parts.pair_figure_data`, sent after the teeth); then the
+    progress pipe is closed. ``{"figures": {name: PNG bytes}, "seconds": float}``."""
+    run, events = _BESIDE["run"], _BESIDE.get("events")
+    progress = run.progress
+    try:
+        figures, start = {}, time.perf_counter()
+        if "plots" in run.stages and not _BESIDE.get("failed"):
+            from cadgen.report.plots.parts import draw_pair_figure
+
+            drawn, seconds = _BESIDE.get("drawn", (0, 0.0))
+            names = list(pairs)
+            while (index := _take(_BESIDE["taken"], len(names))) is not None:
+                figures[names[index]] = draw_pair_figure(pairs[names[index]])
+                # how many this side draws is known only at the end (0: not known)
+                progress.step("plots", names[index], steps=0, beside=True)
+            progress.finished("plots", "ok", time.perf_counter() - start + seconds,
+                              detail="figures", beside=True)
         return {"figures": figures, "seconds": time.perf_counter() - start}
     finally:
         if events is not None:
@@ -197,9 +228,23 @@ def take_meshes(run, beside) -> int:
     return taken
 
 
+def _take(counter, count: int):
+    """The next index below ``count`` from a counter both processes share, or None."""
+    with counter.get_lock():
+        index = counter.value
+        if index >= count:
+            return None
+        counter.value = index + 1
+    return index
+
+
 def collect(run, beside) -> dict:
     """The worker's results: its sweep stages recorded here (as if run here), its figures."""
+    beside.finish()
+    last = beside.pairs.result()
     outcome = {**beside.solids.result(), **beside.figures.result()}
+    outcome["figures"] = {**outcome["figures"], **last["figures"]}
+    outcome["seconds"] += last["seconds"]
     run.progress.join()         # the worker's events, all delivered
     take_meshes(run, beside)
     for stage in beside.sweeps:
@@ -223,19 +268,34 @@ def plots_beside(run, beside):
     worker's (and its sweeps); one record, the two processes' drawing times added."""
     from cadgen.pipeline.figures import figure_jobs
 
-    jobs = {name: draw for name, draw in figure_jobs(run).items() if _shows_gears(name)}
-    run.progress.started("plots", steps=len(jobs))
     start = time.perf_counter()
+    pairs = {}
+    if run.status("teeth") == "ok" and run.values["teeth"].stages:
+        from cadgen.report.plots.parts import pair_figure_datas
+
+        pairs = pair_figure_datas(run.values["teeth"])
+    beside.finish(pairs)        # the worker draws them after its own figures
+    jobs = {name: draw for name, draw in figure_jobs(run).items()
+            if _shows_gears(name) and name not in pairs}
+    run.progress.started("plots")
     take_meshes(run, beside)    # the assembly view meshes every part: the worker's, if made
     mine = {}
     for name, draw in jobs.items():
         mine[name] = draw()
         run.progress.step("plots", name)
     seconds = time.perf_counter() - start
-    if not beside.future.done():   # while the worker finishes: what the writing will need
+    if not beside.done():   # while the worker finishes: what the writing will need
         from cadgen.pipeline.writers import prepare
 
-        prepare(run, beside.future.done)
+        prepare(run, beside.done)
+    if pairs:   # then the pairs' figures the worker has not taken yet
+        from cadgen.report.plots.parts import draw_pair_figure
+
+        begun, names = time.perf_counter(), list(pairs)
+        while (index := _take(beside.taken, len(names))) is not None:
+            mine[names[index]] = draw_pair_figure(pairs[names[index]])
+            run.progress.step("plots", names[index])
+        seconds += time.perf_counter() - begun
     outcome = collect(run, beside)
     theirs = outcome["figures"]
     order = list(figure_jobs(run))     # now with the sweeps' figure

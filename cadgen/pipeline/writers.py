@@ -39,7 +39,9 @@ def writers_for(run) -> list:
 def prepare(run, until) -> int:
     """Make what the writing and the report will need, one piece at a time, until ``until()``
     says stop (the worker beside has finished): the solids' report section, each STL, the
-    assembly file. Made once, they are taken as made later (same bytes). Returns the pieces made.
+    assembly file, the gear files. Made once, they are taken as made later (same bytes; the
+    gear files name their folder only in error messages, and a failure is left for the
+    writing to raise). Returns the pieces made.
     """
     if run.status("parts") != "ok":
         return 0
@@ -56,7 +58,13 @@ def prepare(run, until) -> int:
         for _ in solids_files(outcome):
             made += 1
             if until():
-                break
+                return made
+    if "dxf" in run.effects and run.status("teeth") == "ok" and run.values["teeth"].stages:
+        try:
+            _gear_files(run, Path("gears"))
+            made += 1
+        except Exception:   # said again, with the staging folder's paths, when written
+            run.__dict__.pop("_gear_files", None)
     return made
 
 
@@ -69,12 +77,27 @@ def _write_bom(run, staging):
 
 
 def _write_gears(run, staging):
-    from cadgen.export.train_sheet import write_train_files
+    from cadgen.export.atomic import write_bytes_atomic
 
-    (staging / "gears").mkdir()
-    return [f"gears/{Path(path).name}" for path in
-            write_train_files(run.values["teeth"], staging / "gears",
-                              run.params.gears.chord_tolerance)]
+    folder = staging / "gears"
+    folder.mkdir()
+    written = []
+    for name, data in _gear_files(run, folder):
+        write_bytes_atomic(folder / name, data)
+        written.append(f"gears/{name}")
+    return written
+
+
+def _gear_files(run, folder: Path):
+    """The gear files' ``[(name, bytes)]`` (:func:`cadgen.export.train_sheet.train_files`),
+    made once per run: :func:`prepare` may have made them."""
+    made = run.__dict__.setdefault("_gear_files", {})
+    if "files" not in made:
+        from cadgen.export.train_sheet import train_files
+
+        made["files"] = train_files(run.values["teeth"], run.params.gears.chord_tolerance,
+                                    folder=folder)
+    return made["files"]
 
 
 def _write_cam(run, staging):

@@ -10,7 +10,9 @@ import numpy as np
 from cadgen.report.plots.base import _figure, _fill, _legend_below, _png
 from kinematics.planar import cross
 
-__all__ = ["assembly_view", "pair_figure_jobs", "pair_figures", "clearance_figure"]
+__all__ = ["assembly_view", "pair_figure_jobs", "pair_figures", "pair_figure_data",
+           "pair_figure_datas",
+           "draw_pair_figure", "clearance_figure"]
 
 
 _COLOURS = {"ground": "#b5895a", "housing": "#8fa3b8", "gear": "#d9a441", "cam": "#7a9e7e",
@@ -91,11 +93,18 @@ def assembly_view(assembly, angle: float, *, title: str, paths=(), soil_level=No
 
 def pair_figure_jobs(train) -> dict:
     """``{file name: callable -> PNG bytes}``: a picture of each pair at the start position."""
-    jobs = {}
+    return {name: (lambda stage=stage: _pair_figure(stage)) for name, stage in _pairs(train)}
+
+
+def pair_figure_datas(train) -> dict:
+    """``{file name: pair_figure_data(stage)}`` of each pair, as :func:`pair_figure_jobs`."""
+    return {name: pair_figure_data(stage) for name, stage in _pairs(train)}
+
+
+def _pairs(train):
     for index, stage in enumerate(train.stages):
         slug = re.sub(r"[^a-z0-9]+", "-", stage.name.lower()).strip("-")
-        jobs[f"gears-{index + 1}-{slug}.png"] = lambda stage=stage: _pair_figure(stage)
-    return jobs
+        yield f"gears-{index + 1}-{slug}.png", stage
 
 
 def pair_figures(train) -> dict:
@@ -104,18 +113,34 @@ def pair_figures(train) -> dict:
 
 
 def _pair_figure(stage) -> bytes:
-    figure, ax = _figure(8.0, 5.0)
+    return draw_pair_figure(pair_figure_data(stage))
+
+
+def pair_figure_data(stage) -> dict:
+    """What a pair's picture shows, as plain arrays and strings (it can be sent to another
+    process): each gear's outline and pitch curve placed at the start position, its label,
+    and the title."""
     pair = stage.generated.pair
     rotations = pair.rotations(np.array([0.0]))
+    gears = []
     for k, (profile, check) in enumerate(zip(stage.generated.profiles, stage.generated.checks)):
         outline, pitch = profile.placed(rotations[k][0], (pair.centre_distance * k, 0.0))
-        _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=f"{profile.name} "
-              f"({profile.teeth} teeth, {check.cutter})")
-        ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
+        gears.append((np.asarray(outline), np.asarray(pitch),
+                      f"{profile.name} ({profile.teeth} teeth, {check.cutter})"))
     m = stage.meshing
-    ax.set_title(f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
-                 f"{m.interference_poses} interfering poses of {m.poses}, "
-                 f"TE {m.transmission_error_pp_deg:.1e} deg", fontsize=9)
+    title = (f"{stage.name}: module {stage.generated.system.module:.3f} mm; "
+             f"{m.interference_poses} interfering poses of {m.poses}, "
+             f"TE {m.transmission_error_pp_deg:.1e} deg")
+    return {"gears": gears, "title": title}
+
+
+def draw_pair_figure(data: dict) -> bytes:
+    """The picture of :func:`pair_figure_data`'s pair (PNG bytes)."""
+    figure, ax = _figure(8.0, 5.0)
+    for outline, pitch, label in data["gears"]:
+        _fill(ax, outline[:, 0], outline[:, 1], alpha=0.45, label=label)
+        ax.plot(pitch[:, 0], pitch[:, 1], "k:", lw=0.6)
+    ax.set_title(data["title"], fontsize=9)
     ax.plot([], [], "k:", lw=0.6, label="pitch curves")
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm, along the centre line)")
