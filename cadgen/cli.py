@@ -391,11 +391,11 @@ def entry() -> None:
     a bad command line) leave the usual way.
     """
     import atexit
-    import multiprocessing
     import threading
 
     status = main()
-    if multiprocessing.active_children() or any(
+    processes = sys.modules.get("multiprocessing")   # never imported: no child to wait for
+    if (processes is not None and processes.active_children()) or any(
             not t.daemon for t in threading.enumerate() if t is not threading.main_thread()):
         raise SystemExit(status)
     atexit._run_exitfuncs()

@@ -33,12 +33,13 @@ def input_hash(params) -> str:
 
 
 def _versions() -> dict:
-    import scipy
+    from importlib.metadata import version   # not ``import scipy``: a metrics-only build has
+                                             # no other use for it (7 ms)
 
     from cadgen import __version__
 
     return {"cadgen": __version__, "python": platform.python_version(),
-            "numpy": np.__version__, "scipy": scipy.__version__}
+            "numpy": np.__version__, "scipy": version("scipy")}
 
 
 def report_dict(params, mechanism, evaluation, case: str = "field") -> dict:
