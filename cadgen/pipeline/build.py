@@ -39,6 +39,7 @@ the same input.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
@@ -437,14 +438,31 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     run.effects, run.case, run.cache = effects, case, cache
     run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
                                             for path, (value, source) in knobs.items()}}
-    run.run(STAGE_FUNCTIONS)
-    from cadgen.report.content import assemble_report
+    with _fewer_collections():
+        run.run(STAGE_FUNCTIONS)
+        from cadgen.report.content import assemble_report
 
-    report = assemble_report(run, set_aside)
-    run.report = report
-    if output_root is None:
-        return BuildResult(params.name, report, None)
-    return _write(run, Path(output_root) / params.name)
+        report = assemble_report(run, set_aside)
+        run.report = report
+        if output_root is None:
+            return BuildResult(params.name, report, None)
+        return _write(run, Path(output_root) / params.name)
+
+
+@contextlib.contextmanager
+def _fewer_collections(threshold: int = 20000):
+    """Run the cyclic garbage collector less often during a build (and in the worker forked
+    from it): a build makes millions of short-lived objects and few cycles, and the default
+    (a young collection every 700 allocations) cost 5 % of a full build's time, for 15 MB
+    less memory at most. The thresholds are put back after."""
+    import gc
+
+    before = gc.get_threshold()
+    gc.set_threshold(max(before[0], threshold), max(before[1], 20), max(before[2], 50))
+    try:
+        yield
+    finally:
+        gc.set_threshold(*before)
 
 
 def _write(run, final: Path) -> BuildResult:
