@@ -4,7 +4,7 @@ show no gear, while the building process cuts the gears.
 On a machine with a second core and the fork start method, :func:`start_beside` forks one
 worker when the teeth stage begins. The worker inherits every value computed so far (nothing
 is pickled on the way in), builds the gearless parts, runs the FCL sweeps on them (only where
-the swept parts do not depend on the gears: :data:`GEARLESS_SWEEPS`), then draws every
+the housings do not depend on the gears: the assembly module's ``GEARLESS_KINDS``), then draws every
 figure that shows no gear; its results come back pickled (sweep records and values, PNG
 bytes). The building process cuts the teeth, builds the parts with the gears, draws the
 figures that show gears (:func:`plots_beside`) and then collects the worker's
@@ -21,20 +21,18 @@ from dataclasses import dataclass
 from cadgen.pipeline.build import (STAGE_NEEDS, SWEEP_STAGES, StageRecord, _gearless_parts,
                                    _run_stage)
 
-__all__ = ["GEARLESS_SWEEPS", "start_beside", "collect", "plots_beside"]
+__all__ = ["gearless_kinds", "start_beside", "collect", "plots_beside"]
 
-#: Mechanisms whose parts other than gears and shafts do not depend on the gears, so that a
-#: sweep of the gearless assembly is the sweep of the one written (the shafts' spin is bounded
-#: by the sweep whatever their keyseats' angle). Not the pricking mechanism: its gear case is
-#: drawn round the gears' own outlines (the gearless one is larger), so its sweep waits for them.
-GEARLESS_SWEEPS = frozenset({"planting"})
+
 _BESIDE: dict = {}
 
 
-#: Part kinds the gearless assembly shares with the one built with the gears (planting): the
-#: worker's meshes of these, made for the sweeps, are the building process's too. Not the
-#: gears, not the shafts (their keyseats turn to the gears' keyways).
-SHARED_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground"})
+def gearless_kinds(mechanism: str) -> frozenset:
+    """The part kinds a mechanism's assembly builds the same with or without the gears (its
+    solids module's ``GEARLESS_KINDS``): the worker's meshes of these are the build's."""
+    from importlib import import_module
+
+    return import_module(f"cadgen.solids.{mechanism}").GEARLESS_KINDS
 
 
 @dataclass
@@ -74,8 +72,10 @@ def start_beside(run, functions):
 
     from cadgen.pipeline.figures import _can_fork
 
+    # every sweep holds the housings, the one swept kind the gears may change (the shafts'
+    # spin is bounded whatever their keyseats' angle)
     sweeps = tuple(s for s in SWEEP_STAGES if s in run.stages
-                   and run.params.mechanism in GEARLESS_SWEEPS)
+                   and "housing" in gearless_kinds(run.params.mechanism))
     figures = "plots" in run.stages
     if not (sweeps or figures) or "teeth" not in run.stages or not _can_fork() \
             or any(r.status != "ok" for r in run.records):
@@ -112,7 +112,7 @@ def _beside_solids() -> dict:
     """In the forked worker, first: the gearless parts and each sweep.
 
     ``{"stages": {stage: (record, value)}, "meshes": {part name: (vertices, faces)}}``: the
-    meshes of the parts of :data:`SHARED_KINDS` that the sweeps made.
+    meshes of the parts of :func:`gearless_kinds` that the sweeps made.
     """
     run, functions, sweeps = _BESIDE["run"], _BESIDE["functions"], _BESIDE["sweeps"]
     events, progress = _BESIDE.get("events"), run.progress
@@ -148,9 +148,10 @@ def _beside_solids() -> dict:
                 run.values[stage] = value
         meshes = {}
         if parts_record is not None and parts_record.status == "ok":
+            kinds = gearless_kinds(run.params.mechanism)
             meshes = {part.name: (part._mesh.vertices, part._mesh.faces)
                       for part in run.values["parts"].assembly.parts
-                      if part.kind in SHARED_KINDS and part._mesh is not None}
+                      if part.kind in kinds and part._mesh is not None}
         return {"stages": out, "meshes": meshes}
     except BaseException:
         _BESIDE["failed"] = True    # the next tasks draw nothing
@@ -176,7 +177,7 @@ def _beside_figures() -> dict:
             for name, draw in jobs.items():
                 figures[name] = draw()
                 progress.step("plots", name, beside=True)
-        _BESIDE["drawn"] = (len(figures), time.perf_counter() - start)
+        _BESIDE["drawn"] = time.perf_counter() - start
         return {"figures": figures, "seconds": time.perf_counter() - start}
     except BaseException:
         _BESIDE["failed"] = True
@@ -192,14 +193,10 @@ def _beside_pairs(pairs: dict) -> dict:
     try:
         figures, start = {}, time.perf_counter()
         if "plots" in run.stages and not _BESIDE.get("failed"):
-            from cadgen.report.plots.parts import draw_pair_figure
-
-            drawn, seconds = _BESIDE.get("drawn", (0, 0.0))
-            names = list(pairs)
-            while (index := _take(_BESIDE["taken"], len(names))) is not None:
-                figures[names[index]] = draw_pair_figure(pairs[names[index]])
-                # how many this side draws is known only at the end (0: not known)
-                progress.step("plots", names[index], steps=0, beside=True)
+            seconds = _BESIDE.get("drawn", 0.0)   # its figures before these
+            # how many this side draws is known only at the end (steps 0: not known)
+            figures = _draw_taken(pairs, _BESIDE["taken"], lambda name: progress.step(
+                "plots", name, steps=0, beside=True))
             progress.finished("plots", "ok", time.perf_counter() - start + seconds,
                               detail="figures", beside=True)
         return {"figures": figures, "seconds": time.perf_counter() - start}
@@ -209,23 +206,32 @@ def _beside_pairs(pairs: dict) -> dict:
 
 
 def take_meshes(run, beside) -> int:
-    """Give this build's parts the worker's meshes of the same parts (:data:`SHARED_KINDS`)
+    """Give this build's parts the worker's meshes of the same parts (:func:`gearless_kinds`)
     where it made them and this process has not yet: the same triangles, not made twice.
     Returns how many were taken (none before the worker's first task is done)."""
     if not beside.solids.done() or run.status("parts") != "ok":
         return 0
-    import trimesh
+    from cadgen.solids.extrude import part_mesh
 
-    meshes = beside.solids.result()["meshes"]
+    meshes, kinds = beside.solids.result()["meshes"], gearless_kinds(run.params.mechanism)
     taken = 0
     for part in run.values["parts"].assembly.parts:
-        if part.kind in SHARED_KINDS and part._mesh is None and part.name in meshes:
-            vertices, faces = meshes[part.name]
-            # as cadgen.solids.extrude.to_trimesh made it in the worker (checked there)
-            part._mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False,
-                                         metadata={"name": part.name})
+        if part.kind in kinds and part._mesh is None and part.name in meshes:
+            part._mesh = part_mesh(*meshes[part.name], part.name)   # checked in the worker
             taken += 1
     return taken
+
+
+def _draw_taken(pairs: dict, counter, drawn) -> dict:
+    """Draw the gear pairs' figures that neither process has taken yet, taking them one at a
+    time from ``counter`` (shared by both); ``drawn(name)`` after each. Returns the PNGs."""
+    from cadgen.report.plots.parts import draw_pair_figure
+
+    names, figures = list(pairs), {}
+    while (index := _take(counter, len(names))) is not None:
+        figures[names[index]] = draw_pair_figure(pairs[names[index]])
+        drawn(names[index])
+    return figures
 
 
 def _take(counter, count: int):
@@ -288,26 +294,21 @@ def plots_beside(run, beside):
         from cadgen.pipeline.writers import prepare
 
         prepare(run, beside.done)
-    if pairs:   # then the pairs' figures the worker has not taken yet
-        from cadgen.report.plots.parts import draw_pair_figure
-
-        begun, names = time.perf_counter(), list(pairs)
-        while (index := _take(beside.taken, len(names))) is not None:
-            mine[names[index]] = draw_pair_figure(pairs[names[index]])
-            run.progress.step("plots", names[index])
-        seconds += time.perf_counter() - begun
+    begun = time.perf_counter()   # then the pairs' figures the worker has not taken yet
+    mine.update(_draw_taken(pairs, beside.taken, lambda name: run.progress.step("plots", name)))
+    seconds += time.perf_counter() - begun
     outcome = collect(run, beside)
     theirs = outcome["figures"]
-    order = list(figure_jobs(run))     # now with the sweeps' figure
+    every = figure_jobs(run)     # now with the sweeps' figure
     # any figure the worker could not draw (its gearless parts failed): drawn here
-    for name, draw in figure_jobs(run).items():
+    for name, draw in every.items():
         if name not in mine and name not in theirs:
             begun = time.perf_counter()
             mine[name] = draw()
             seconds += time.perf_counter() - begun
             run.progress.step("plots", name)
     figures = {**mine, **theirs}
-    run.figures = {name: figures[name] for name in order if name in figures}
+    run.figures = {name: figures[name] for name in every if name in figures}
     # the stage's time: both processes' drawing (the work), each said in the message
     record = StageRecord("plots", "ok", seconds + outcome["seconds"],
                          f"{len(theirs)} of {len(run.figures)} figures drawn beside the teeth, "

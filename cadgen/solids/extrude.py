@@ -20,7 +20,7 @@ from cadgen.solids.outline import holes_problems, outline_problems, signed_area
 from cadgen.solids.tolerances import CROSS_SECTION_AREA_RTOL, DEGENERATE_AREA_RTOL
 from kinematics.errors import DesignError, Problem
 
-__all__ = ["extrude", "cross_section", "to_trimesh", "from_trimesh"]
+__all__ = ["extrude", "cross_section", "to_trimesh", "part_mesh", "from_trimesh"]
 
 
 def cross_section(outline, *, holes=(), path: str = "solid", holes_path: str | None = None,
@@ -175,8 +175,6 @@ def to_trimesh(manifold, name: str):
         empty mesh is not a part), ``engine_status``, ``watertight``,
         ``winding_consistent`` or ``positive_volume``.
     """
-    import trimesh
-
     _check_status(manifold, name)
     if manifold.is_empty():
         raise SolidError(name, "not_empty", "the solid has no triangles (a boolean removed everything?)")
@@ -190,11 +188,19 @@ def to_trimesh(manifold, name: str):
         target = np.arange(len(vertices))
         target[merge_from] = np.asarray(mesh.merge_to_vert, dtype=np.int64)
         faces = target[faces]
-    result = trimesh.Trimesh(vertices=vertices, faces=faces, process=False, metadata={"name": name})
+    result = part_mesh(vertices, faces, name)
     if merge_from.size:
         result.remove_unreferenced_vertices()
     _check_volume(result, name)
     return result
+
+
+def part_mesh(vertices, faces, name: str):
+    """The ``trimesh.Trimesh`` of a part's triangles as :func:`to_trimesh` makes it (no
+    processing, the part's name in its metadata); unchecked."""
+    import trimesh
+
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False, metadata={"name": name})
 
 
 def _check_volume(mesh, name: str) -> None:

@@ -42,7 +42,13 @@ import numpy as np
 
 from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
 
-__all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius"]
+__all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius", "GEARLESS_KINDS"]
+
+#: Part kinds built the same with or without the gears: the housings come from the
+#: drivetrain's stacks, not from the gears' outlines. Not the gears, not the shafts (each
+#: keyseat turns to its gear's keyway). A build sweeps the gearless assembly beside the teeth
+#: and takes these parts' meshes from it (:mod:`cadgen.pipeline.beside`).
+GEARLESS_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground"})
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,13 @@ import numpy as np
 
 from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
 
-__all__ = ["pricking_assembly"]
+__all__ = ["pricking_assembly", "GEARLESS_KINDS"]
+
+#: Part kinds built the same with or without the gears (see
+#: :data:`cadgen.solids.planting.GEARLESS_KINDS`). Not the gear case: it is drawn round the
+#: gears' own outlines (without them, round a coarser and larger envelope), so its sweep
+#: waits for the gears.
+GEARLESS_KINDS = frozenset({"rocker", "needle", "ground"})
 
 
 def _carrier_angle(design, angle):
