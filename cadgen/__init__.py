@@ -61,6 +61,9 @@ _EXPORTS = {
     "expand_grid": "cadgen.batch",
     "file_jobs": "cadgen.batch",
     "add_batch_arguments": "cadgen.batch",
+    # the studio: the design page in the browser (cadgen studio)
+    "run_studio": "cadgen.studio.run",
+    "StudioPortError": "cadgen.studio.run",
     # writing files atomically
     "write_bytes_atomic": "cadgen.export.atomic",
     "write_text_atomic": "cadgen.export.atomic",

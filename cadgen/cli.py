@@ -1,5 +1,6 @@
 """Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``), ``cadgen batch``,
-``cadgen new`` (a starting parameter file) and ``cadgen cache clear|info`` (the gear cache).
+``cadgen new`` (a starting parameter file), ``cadgen cache clear|info`` (the gear cache) and
+``cadgen studio`` (the design page in the browser).
 
 Exit codes (every command):
 
@@ -28,6 +29,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+# the one-line report and crash file of a bug, shared with the studio's server and builds
+from cadgen.crash import CRASH_DIR_VARIABLE, one_line as _one_line
+from cadgen.crash import write_crash_file as _write_crash_file
+
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_CHECKS_FAILED", "EXIT_PROBLEMS",
            "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE", "CRASH_DIR_VARIABLE"]
 
@@ -40,10 +45,6 @@ EXIT_INTERNAL = 3
 EXIT_INTERRUPTED = 130
 #: The reader of the output went away (128 + SIGPIPE, the shell's convention).
 EXIT_BROKEN_PIPE = 141
-#: Environment variable naming the directory of crash files (default: the temporary one).
-CRASH_DIR_VARIABLE = "CADGEN_CRASH_DIR"
-#: The longest exception message printed on the one line (the crash file has it whole).
-_MESSAGE_CHARACTERS = 300
 
 
 def _version() -> str:
@@ -249,7 +250,60 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
         "entries and size; 'clear' removes every entry and prints what it removed.")
     cache.add_argument("action", choices=("info", "clear"), help="what to do")
     cache.set_defaults(handler=_cmd_cache)
+
+    studio = commands.add_parser(
+        "studio", help="design in the browser: live metrics, draggable points, animation",
+        description="Start the studio, a local web page to design FILE interactively (the "
+        "bundled paper design when FILE is left out): a server on 127.0.0.1 behind a random "
+        "token, whose URL is printed and opened in the browser. Ctrl-C stops it (exit 130); "
+        "a FILE with problems or a port in use: exit 2.")
+    studio.add_argument("file", metavar="FILE", nargs="?", default=None,
+                        help="TOML parameter file to open (default: the bundled paper design, "
+                             "read-only: save it under a new name)")
+    studio.add_argument("--port", metavar="N", type=_port, default=0,
+                        help="port to listen on (default: a free one)")
+    studio.add_argument("--no-browser", action="store_true",
+                        help="print the URL without opening a browser")
+    studio.add_argument("--output-dir", metavar="DIR", default="outputs",
+                        help="root of the build output folders (default: %(default)s)")
+    studio.set_defaults(handler=_cmd_studio)
     return parser
+
+
+def _port(text: str) -> int:
+    """argparse type of ``--port``: 0 (a free port) to 65535."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"must be between 0 and 65535, got {value}")
+    return value
+
+
+def _cmd_studio(args: argparse.Namespace) -> int:
+    """``cadgen studio``: check FILE, bind the port, print the URL, serve until Ctrl-C."""
+    import cadgen
+
+    try:
+        # uvicorn turns Ctrl-C into a clean shutdown, then raises it again once stopped:
+        # main() reports it as "cadgen: interrupted", exit 130
+        cadgen.run_studio(args.file, port=args.port, open_browser=not args.no_browser,
+                          output_root=Path(args.output_dir),
+                          announce=lambda url: print(f"cadgen studio: {url}", flush=True))
+    # the except clauses name the classes only when something is raised: run_studio loads
+    # numpy single-threaded first, so nothing here may import the parameter models before
+    except cadgen.ParameterError as exc:
+        for problem in exc.problems:
+            print(f"{args.file}: {problem}", file=sys.stderr)
+        return EXIT_PROBLEMS
+    except cadgen.MechanismError as exc:
+        print(f"{args.file}: {_one_line(exc)} [{type(exc).__name__}]", file=sys.stderr)
+        return EXIT_PROBLEMS
+    except cadgen.StudioPortError as exc:
+        print(f"cadgen studio: {exc.strerror}", file=sys.stderr)
+        return EXIT_PROBLEMS
+    return EXIT_OK
 
 
 def _cmd_new(args: argparse.Namespace) -> int:
@@ -272,47 +326,6 @@ def _cmd_new(args: argparse.Namespace) -> int:
     print(f"wrote {path} ({args.kind}, from the bundled example); next: "
           f"cadgen validate {path} && cadgen build {path}")
     return EXIT_OK
-
-
-def _one_line(text: str, limit: int = _MESSAGE_CHARACTERS) -> str:
-    text = " ".join(str(text).split())
-    return text if len(text) <= limit else text[:limit - 3] + "..."
-
-
-def _write_crash_file(error: BaseException, argv: Sequence[str]) -> Path:
-    """Save the traceback, the versions and the command line; the file's path.
-
-    In ``$CADGEN_CRASH_DIR`` (made if missing) or :func:`tempfile.gettempdir`, named
-    ``cadgen-crash-<date>-<time>-<pid>.txt`` (a counter added if that exists).
-    Raises OSError when it cannot be written.
-    """
-    import datetime
-    import platform
-    import tempfile
-    import traceback
-
-    directory = Path(os.environ.get(CRASH_DIR_VARIABLE) or tempfile.gettempdir())
-    directory.mkdir(parents=True, exist_ok=True)
-    now = datetime.datetime.now()
-    stem = f"cadgen-crash-{now:%Y%m%d-%H%M%S}-{os.getpid()}"
-    try:
-        version = _version()
-    except Exception as exc:   # a broken install must not hide the crash being reported
-        version = f"unknown ({type(exc).__name__}: {exc})"
-    text = (f"cadgen {version} internal error at {now.isoformat(timespec='seconds')}\n"
-            f"python {platform.python_version()} ({sys.executable}) on {platform.platform()}\n"
-            f"argv: {[sys.argv[0] if sys.argv else 'cadgen', *argv]!r}\n"
-            f"working directory: {os.getcwd()}\n\n"
-            + "".join(traceback.format_exception(error)))
-    for attempt in range(100):
-        path = directory / (stem + (f"-{attempt}" if attempt else "") + ".txt")
-        try:
-            with open(path, "x", encoding="utf-8") as stream:
-                stream.write(text)
-        except FileExistsError:
-            continue
-        return path
-    raise FileExistsError(f"every crash file name {stem}-*.txt in {directory} is taken")
 
 
 def _internal_error(error: BaseException, argv: Sequence[str]) -> int:

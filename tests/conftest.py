@@ -1,5 +1,7 @@
-"""Shared fixtures: the paper's planting design as a kinematic model."""
+"""Shared fixtures: the paper's planting design as a kinematic model; the headless browser."""
 
+import importlib.util
+import os
 from pathlib import Path
 
 import numpy as np
@@ -58,3 +60,42 @@ def _session_gear_cache(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("CADGEN_CACHE_DIR", str(tmp_path_factory.mktemp("gear-cache")))
         yield
+
+
+def load_script(name: str):
+    """``scripts/<name>.py`` as a module (the screenshot scripts hold the page checks)."""
+    spec = importlib.util.spec_from_file_location(name, REPO / "scripts" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _browser_unavailable(reason: str):
+    if os.environ.get("CI") == "true":
+        pytest.fail(f"{reason}: CI must run the browser tests (.ci/run installs chromium)")
+    pytest.skip(reason)
+
+
+@pytest.fixture(scope="session")
+def chromium():
+    """Debian's Chromium for Playwright: skipped without it locally, failed under CI=true."""
+    executable = load_script("report_screenshots").find_chromium()
+    if executable is None:
+        _browser_unavailable("Chromium is not installed (apt-get install -y chromium)")
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        _browser_unavailable("Playwright for Python is not installed (pip install -e '.[test]')")
+    return executable
+
+
+@pytest.fixture(scope="module")
+def browser(chromium):
+    """One headless Chromium per test module (its pages are the tests' own)."""
+    from playwright.sync_api import sync_playwright
+
+    launch = load_script("report_screenshots").launch
+    with sync_playwright() as playwright:
+        browser = launch(playwright, chromium)
+        yield browser
+        browser.close()

@@ -20,6 +20,7 @@ REPO = Path(__file__).resolve().parents[1]
 #: sits above them (it imports them inside its functions).
 ALLOWED = {
     "kinematics": set(),
+    "cadgen.crash": {"cadgen"},      # a bug's one line and crash file (cli, studio)
     "cadgen.geometry": set(),
     # loading calls the design checks, inside a function (see cadgen.params.feasibility)
     "cadgen.params": {"kinematics", "cadgen.params.feasibility"},
@@ -40,7 +41,12 @@ ALLOWED = {
                         "cadgen.geometry", "cadgen.gears", "cadgen.cam", "cadgen.machine",
                         "cadgen.solids", "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report"},
     "cadgen.batch": {"kinematics", "cadgen.params", "cadgen.export", "cadgen.pipeline"},
-    "cadgen.cli": {"cadgen"},        # the command line uses the public API only
+    # the studio: over the public API, the parameter models (its form's schema, its saves),
+    # the evaluation's sections as report.json holds them, and the build's stage plan
+    "cadgen.studio": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.cam",
+                      "cadgen.solids", "cadgen.report", "cadgen.export", "cadgen.pipeline",
+                      "cadgen.crash"},
+    "cadgen.cli": {"cadgen", "cadgen.crash"},   # the command line uses the public API only
     "cadgen.__main__": {"cadgen.cli"},
     "cadgen": set(),                 # the API imports lazily, by name (see its _EXPORTS)
 }

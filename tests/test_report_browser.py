@@ -10,12 +10,11 @@ GLB and drew it (pixels unlike its background), the animation's frame advances,
 no script error, and nothing fetched but the page itself.
 """
 
-import importlib.util
-import os
 import time
 from pathlib import Path
 
 import pytest
+from conftest import load_script
 
 from cadgen import build, load_params
 
@@ -28,43 +27,7 @@ EFFECTS = ["metrics", "solids", "stl", "plots", "report"]
 WIDTHS = (1280, 1024, 820)
 
 
-def _shots():
-    spec = importlib.util.spec_from_file_location(
-        "report_screenshots", REPO / "scripts" / "report_screenshots.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-SHOTS = _shots()
-
-
-def _unavailable(reason: str):
-    if os.environ.get("CI") == "true":
-        pytest.fail(f"{reason}: CI must run the browser test (.ci/run installs chromium)")
-    pytest.skip(reason)
-
-
-@pytest.fixture(scope="module")
-def chromium():
-    executable = SHOTS.find_chromium()
-    if executable is None:
-        _unavailable("Chromium is not installed (apt-get install -y chromium)")
-    try:
-        import playwright.sync_api  # noqa: F401
-    except ImportError:
-        _unavailable("Playwright for Python is not installed (pip install -e '.[test]')")
-    return executable
-
-
-@pytest.fixture(scope="module")
-def browser(chromium):
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        browser = SHOTS.launch(playwright, chromium)
-        yield browser
-        browser.close()
+SHOTS = load_script("report_screenshots")
 
 
 @pytest.fixture(scope="module")

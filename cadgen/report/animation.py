@@ -28,7 +28,7 @@ import numpy as np
 from kinematics.planar import perp as _perp, unit as _unit
 
 __all__ = ["POSES", "animation_data", "planting_animation", "pricking_animation",
-           "animation_section"]
+           "animation_section", "placed"]
 
 #: Poses per carrier turn (2 degrees apart).
 POSES = 180
@@ -85,6 +85,11 @@ def _placed(local, origin, angle) -> np.ndarray:
     axis = _unit(angle)[:, None, :]
     return (np.asarray(origin)[:, None, :] + local[None, :, :1] * axis
             + local[None, :, 1:] * _perp(axis))
+
+
+#: Public name of :func:`_placed` for the studio's animation (cadgen.studio.animation), which
+#: places its gears, housings and blades in moving frames the same way.
+placed = _placed
 
 
 def planting_animation(params, mechanism, evaluation=None, poses: int = POSES) -> dict:

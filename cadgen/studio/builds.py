@@ -1,0 +1,419 @@
+"""Builds started from the studio: one at a time, in a process of their own, progress streamed.
+
+:class:`BuildJobs` validates the design in the server's process (a bad design is an
+answer to the request, not a failed job), then runs :func:`cadgen.build` in a child
+process that is a fresh interpreter (``python -m cadgen.studio.builds``, the design on
+stdin as JSON), as the "spawn" start method makes one: the server has threads and an
+event loop, and a forked copy of a threaded process can hang on a lock some other thread
+held. Not a :mod:`multiprocessing` "spawn" child itself: that one first re-runs the
+server's main script, all of it when the script lacks the ``if __name__ == "__main__"``
+guard (a probe script of the studio did, and built in a loop). The child's own process
+group holds the build's forked workers too (the sweeps beside the teeth, the figures),
+so stopping a build stops all of them.
+
+The child turns each :class:`~cadgen.pipeline.progress.ProgressEvent` into a plain dict
+(``{"type": "progress", "stage", "status": "start|step|end", "elapsed_s", "done",
+"total", "text", ...}``, ``text`` the line ``cadgen build`` prints in a log) and sends it
+through a pipe; at the end one ``{"type": "done", "exit_code", "report", "glb", "summary",
+"error"}``. A pipe (a :class:`multiprocessing.connection.Connection` on its file
+descriptor) rather than a :class:`multiprocessing.Queue`: a queue's feeder thread in the
+child would be copied, perhaps holding its lock, into the workers the build forks.
+
+In the server, a thread per job reads the pipe into the job's event list;
+:meth:`BuildJobs.events` replays that list to any subscriber, late ones included, and
+then waits for more (woken through its event loop). A child that dies without its
+``done`` (killed, out of memory) still ends the job: ``done`` with exit code 3 and
+"the build process died (signal N)".
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import os
+import secrets
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from cadgen import MechanismError
+from cadgen.crash import one_line, write_crash_file
+
+__all__ = ["BuildJobs", "BuildJob", "BuildBusy", "UnknownJob", "EXIT_INTERNAL",
+           "EXIT_STOPPED"]
+
+#: Exit code of a build that crashed or whose process died (the CLI's "internal error").
+EXIT_INTERNAL = 3
+#: Exit code of a build stopped by :meth:`BuildJobs.shutdown` (the CLI's Ctrl-C code).
+EXIT_STOPPED = 130
+#: Seconds a stopped build gets to clean its staging folder before it is killed.
+STOP_GRACE_SECONDS = 10.0
+#: Seconds between checks that the child is alive while its pipe is quiet.
+POLL_SECONDS = 0.2
+#: Finished jobs kept for late subscribers (a designer's session starts a few dozen).
+KEPT_JOBS = 32
+
+_STATUS = {"started": "start", "step": "step", "finished": "end"}
+
+
+class BuildBusy(MechanismError):
+    """A build is already running (the studio runs one at a time)."""
+
+
+class UnknownJob(MechanismError, KeyError):
+    """No build has this id (also a KeyError, as a mapping lookup would raise)."""
+
+    def __str__(self) -> str:
+        return f"no build {self.args[0]!r}" if self.args else "no such build"
+
+
+@dataclass
+class BuildJob:
+    """One build: its events so far and, once over, its ``done`` event.
+
+    ``events`` holds every event in order, the final ``done`` included; :meth:`BuildJobs.get`
+    returns a copy, so reading it needs no lock.
+    """
+
+    id: str
+    name: str
+    pid: int | None = None
+    events: list = field(default_factory=list)
+    done: dict | None = None
+
+    @property
+    def running(self) -> bool:
+        return self.done is None
+
+
+class _Job(BuildJob):
+    """The live job (the server's side): the child, the pipe, the waiting subscribers."""
+
+    def __init__(self, id: str, name: str):
+        super().__init__(id, name)
+        self.lock = threading.Lock()
+        self.waiters: list = []      # (event loop, asyncio.Event) of subscribers waiting
+        self.process = None
+        self.drain = None            # the thread reading the child's pipe; the only joiner
+        self.stopping = False
+
+    def add(self, event: dict) -> None:
+        with self.lock:
+            if self.done is not None:
+                return               # after done nothing counts (a late message of a dying child)
+            self.events.append(event)
+            if event.get("type") == "done":
+                self.done = event
+            waiters, self.waiters = self.waiters, []
+        for loop, wake in waiters:
+            try:
+                loop.call_soon_threadsafe(wake.set)
+            except RuntimeError:     # that subscriber's loop is closed: nobody to wake
+                pass
+
+    def snapshot(self) -> BuildJob:
+        with self.lock:
+            return BuildJob(self.id, self.name, self.pid, list(self.events), self.done)
+
+
+class BuildJobs:
+    """The studio's builds into ``output_root`` (``<output_root>/<name>/``), one at a time.
+
+    Parameters
+    ----------
+    output_root : Path
+        Where builds write; the ``done`` event's links are relative to it
+        (``/files/<name>/report.html``).
+    """
+
+    def __init__(self, output_root: Path):
+        self.output_root = Path(output_root)
+        self._jobs: dict = {}
+        self._lock = threading.Lock()
+
+    # ------------------------------------------------------------------ starting
+    def start(self, params: dict) -> str:
+        """Validate ``params`` and start building them; the job's id.
+
+        Raises
+        ------
+        cadgen.ParameterError
+            The design does not validate, or a problem of a stage its scene runs (the
+            duckbill linkage when the cam is built): what ``cadgen build`` refuses.
+        BuildBusy
+            A build is running.
+        """
+        from cadgen import validate_data
+        from cadgen.pipeline.build import plan, stage_warnings
+
+        validated = validate_data(params)
+        scene = validated.scene
+        stage_warnings(validated, plan(scene.effects, validated.mechanism, scene.case)[0])
+        with self._lock:
+            running = [job for job in self._jobs.values() if job.running]
+            if running:
+                raise BuildBusy(f"the build of {running[0].name} is still running")
+            job = _Job(secrets.token_urlsafe(9), validated.name)
+            process, receiving = _start_child(params, self.output_root)
+            job.process, job.pid = process, process.pid
+            self._jobs[job.id] = job
+            self._forget_old_jobs()
+        job.drain = threading.Thread(target=self._drain, args=(job, receiving), daemon=True,
+                                     name=f"cadgen-studio-build-{job.id}")
+        job.drain.start()
+        return job.id
+
+    def _forget_old_jobs(self) -> None:
+        finished = [job_id for job_id, job in self._jobs.items() if not job.running]
+        for job_id in finished[:max(0, len(self._jobs) - KEPT_JOBS)]:
+            del self._jobs[job_id]
+
+    # ------------------------------------------------------------------ the child's messages
+    def _drain(self, job: _Job, receiving) -> None:
+        """Read the child's events into the job until its ``done``, or its death."""
+        process = job.process
+        while job.done is None:
+            try:
+                if not receiving.poll(POLL_SECONDS):
+                    if process.poll() is None:
+                        continue
+                    if not receiving.poll(0):   # dead, and nothing left in the pipe
+                        break
+                message = receiving.recv()
+            except (EOFError, OSError):    # every writer gone: the child ended
+                break
+            except Exception:   # a message cut short by the child's death: unreadable
+                break
+            job.add(message)
+        receiving.close()
+        try:
+            process.wait(STOP_GRACE_SECONDS)
+        except subprocess.TimeoutExpired:   # said done but does not end (a worker it awaits)
+            _signal_group(process.pid, signal.SIGKILL)
+            process.wait()
+        if job.done is None:
+            job.add(_done(EXIT_STOPPED if job.stopping else EXIT_INTERNAL,
+                          error=_death(process.returncode, job.stopping)))
+
+    # ------------------------------------------------------------------ reading
+    def get(self, job_id: str) -> BuildJob:
+        """A copy of the job's state (``events``, ``done``, ``pid``); UnknownJob if none."""
+        return self._job(job_id).snapshot()
+
+    def _job(self, job_id: str) -> _Job:
+        with self._lock:
+            job = self._jobs.get(job_id)
+        if job is None:
+            raise UnknownJob(job_id)
+        return job
+
+    async def events(self, job_id: str):
+        """Every event of the job, from the first, then new ones as they come; ends after
+        ``done``. Raises UnknownJob (a KeyError) at the first step when there is no such job.
+        """
+        job = self._job(job_id)
+        loop = asyncio.get_running_loop()
+        sent = 0
+        while True:
+            wake = asyncio.Event()
+            with job.lock:
+                new = job.events[sent:]
+                if not new:
+                    job.waiters.append((loop, wake))
+            for event in new:
+                yield event
+                sent += 1
+                if event.get("type") == "done":
+                    return
+            if not new:
+                try:   # the timeout only guards against a lost wake-up
+                    await asyncio.wait_for(wake.wait(), timeout=1.0)
+                except asyncio.TimeoutError:
+                    pass
+
+    # ------------------------------------------------------------------ stopping
+    def shutdown(self, timeout: float = STOP_GRACE_SECONDS) -> None:
+        """Stop a running build (its process group: the child and the workers it forked).
+
+        SIGTERM first, so the build removes its staging folder; SIGKILL after ``timeout``.
+        The job ends with ``done``, exit code 130, "the build was stopped". Returns once
+        the child is reaped (by the job's pipe reader: one thread only waits for a child,
+        two would race for its exit status).
+        """
+        with self._lock:
+            running = [job for job in self._jobs.values() if job.running]
+        for job in running:
+            job.stopping = True
+            _signal_group(job.pid, signal.SIGTERM)
+        for job in running:
+            job.drain.join(timeout)
+            if job.drain.is_alive():
+                _signal_group(job.pid, signal.SIGKILL)
+                job.drain.join(timeout)
+
+
+def _start_child(params: dict, output_root: Path):
+    """Start ``python -m cadgen.studio.builds`` on ``params``: ``(Popen, receiving end)``."""
+    from multiprocessing.connection import Connection
+
+    import cadgen
+
+    reading, writing = os.pipe()
+    environment = dict(os.environ)
+    # the cadgen this server runs, even from a source tree that was never installed
+    source = str(Path(cadgen.__file__).resolve().parents[1])
+    environment["PYTHONPATH"] = os.pathsep.join(
+        [source, *filter(None, [environment.get("PYTHONPATH")])])
+    try:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "cadgen.studio.builds", str(writing)],
+            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, pass_fds=(writing,),
+            env=environment,
+            # a group of its own: shutdown() signals it and the workers the build forks,
+            # and the terminal's Ctrl-C reaches the server only, which stops it
+            process_group=0)
+    except BaseException:
+        os.close(reading)
+        raise
+    finally:
+        os.close(writing)   # the child's copy is the last: its death closes the pipe
+    request = json.dumps({"params": params, "output_root": str(output_root)}).encode()
+    try:
+        process.stdin.write(request)
+    except OSError:         # it died at once: the pipe's end says so
+        pass
+    finally:
+        try:
+            process.stdin.close()
+        except OSError:
+            pass
+    return process, Connection(reading, writable=False)
+
+
+def _signal_group(pid: int | None, signum: int) -> None:
+    """Signal the child's process group (the child and the workers its build forked)."""
+    if pid is None:
+        return
+    try:
+        os.killpg(pid, signum)
+    except (ProcessLookupError, PermissionError):   # every process of it gone already
+        pass
+
+
+def _death(exitcode: int | None, stopping: bool) -> str:
+    # Popen's return code: negative for the signal that ended the process
+    if stopping:
+        return "the build was stopped (the studio is closing)"
+    if exitcode is not None and exitcode < 0:
+        return f"the build process died (signal {-exitcode})"
+    return f"the build process died (exit status {exitcode})"
+
+
+def _done(exit_code: int, *, report=None, glb=None, summary: str = "", error=None,
+          elapsed_s: float | None = None) -> dict:
+    return {"type": "done", "exit_code": exit_code, "report": report, "glb": glb,
+            "summary": summary, "error": error, "elapsed_s": elapsed_s}
+
+
+# --------------------------------------------------------------------------- the child
+def _child_main(arguments: list) -> None:
+    """``python -m cadgen.studio.builds FD``: the design on stdin, events down the pipe FD."""
+    from multiprocessing.connection import Connection
+
+    sending = Connection(int(arguments[0]), readable=False)
+    request = json.loads(sys.stdin.buffer.read())
+    _child_build(request["params"], request["output_root"], sending)
+
+
+def _child_build(params: dict, output_root: str, sending) -> None:
+    """In the child: build ``params`` into ``output_root``, events to ``sending``."""
+    owner = os.getpid()
+
+    def stop(signum, frame):
+        if os.getpid() != owner:   # a build worker forked from here: end quietly
+            os._exit(EXIT_STOPPED)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the server decides when to stop
+    start = time.perf_counter()
+    try:
+        done = _build_in_child(params, Path(output_root), sending)
+    except KeyboardInterrupt:
+        done = _done(EXIT_STOPPED, error="the build was stopped (the studio is closing)")
+    except BaseException as error:   # a bug: one line here, the traceback in a crash file
+        done = _done(EXIT_INTERNAL, error=_crash(error, params))
+    done["elapsed_s"] = round(time.perf_counter() - start, 3)
+    _send(sending, done)
+    sending.close()
+
+
+def _send(sending, message: dict) -> None:
+    """Send ``message`` to the server; nobody reading (the server went away) is no error:
+    the build goes on and its outputs are written all the same."""
+    try:
+        sending.send(message)
+    except OSError:
+        pass
+
+
+def _build_in_child(params: dict, output_root: Path, sending) -> dict:
+    from cadgen import OutputDirError, ParameterError, build, validate_data
+
+    progress = _ProgressRelay(sending)
+    try:
+        validated = validate_data(params)
+        result = build(validated, output_root=output_root, progress=progress)
+    except (ParameterError, OutputDirError) as error:   # what `cadgen build` exits 2 for
+        return _done(2, error=one_line(error))
+    files = set(result.files)
+    folder = "/files/" + result.output_dir.relative_to(output_root).as_posix()
+    return _done(result.exit_code,
+                 report=f"{folder}/report.html" if "report.html" in files else None,
+                 glb=f"{folder}/solids/assembly.glb" if "solids/assembly.glb" in files
+                 else None,
+                 summary=result.summary_text())
+
+
+class _ProgressRelay:
+    """The build's progress callback in the child: each event as a dict down the pipe,
+    its ``text`` the line the command line's printer writes to a log."""
+
+    def __init__(self, sending):
+        import io
+
+        from cadgen import ProgressPrinter
+
+        self.sending = sending
+        self.lines = io.StringIO()
+        self.printer = ProgressPrinter(self.lines, tty=False)
+
+    def __call__(self, event) -> None:
+        self.printer(event)
+        text = self.lines.getvalue().strip()
+        self.lines.seek(0)
+        self.lines.truncate()
+        _send(self.sending, {
+            "type": "progress", "stage": event.stage, "status": _STATUS[event.state],
+            "elapsed_s": round(event.elapsed, 3), "done": event.step, "total": event.steps,
+            "text": text, "seconds": round(event.seconds, 3),
+            "outcome": event.status or None, "detail": event.detail, "beside": event.beside})
+
+
+def _crash(error: BaseException, params: dict) -> str:
+    """``internal error: ...`` on one line, the traceback saved as the command line saves it."""
+    name = params.get("name") if isinstance(params, dict) else None
+    try:
+        saved = f"traceback saved to {write_crash_file(error, ['studio', 'build', str(name)])}"
+    except Exception as exc:
+        saved = f"the traceback could not be saved: {one_line(exc, 120)}"
+    return (f"internal error: {type(error).__name__}: {one_line(error)} "
+            f"(please report it; {saved})")
+
+
+if __name__ == "__main__":
+    _child_main(sys.argv[1:])
