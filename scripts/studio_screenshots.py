@@ -181,6 +181,7 @@ def _shoot_planting(browser, url: str, out: Path) -> tuple[list, list]:
     page.locator(".anim-event.lowest").click()   # the tip at its lowest point, in the soil
     page.locator("#panel-animation").screenshot(path=str(out / "planting-animation-absolute.png"))
     written.append(out / "planting-animation-absolute.png")
+    written += _shoot_build(page, out, "planting")
     problems += page_problems(page, requests, errors)
     page.close()
     return written, problems
@@ -208,6 +209,25 @@ def _shoot_pricking(browser, url: str, out: Path) -> tuple[list, list]:
     problems += page_problems(page, requests, errors)
     page.close()
     return written, problems
+
+
+def _shoot_build(page, out: Path, name: str) -> list:
+    """Press Build (the file's own scene: every effect), wait for the 3D view, shoot it with
+    the covers on and off."""
+    page.set_viewport_size({"width": 1280, "height": 1000})
+    page.locator("#build").click()
+    page.wait_for_function("document.querySelector('.viewer')"
+                           " && document.querySelector('.viewer').dataset.state === 'ready'",
+                           timeout=180000)
+    page.wait_for_timeout(500)
+    panel = page.locator("#panel-build")
+    panel.scroll_into_view_if_needed()
+    written = [out / f"{name}-build.png", out / f"{name}-build-covers-hidden.png"]
+    panel.screenshot(path=str(written[0]))
+    page.locator(".viewer-buttons button", has_text="Hide housing covers").click()
+    page.wait_for_timeout(300)
+    panel.screenshot(path=str(written[1]))
+    return written
 
 
 def screenshots(out: Path, chromium: str) -> int:
