@@ -16,6 +16,9 @@ The closure quadrature (periodic trapezoid rule) is measured per node count
 against the converged centre distance, with the 1-degree rectangle rule as the
 paper's peer.
 
+The population screen of ``cadgen optimize`` (its grid samples per revolution) against
+the exact path, see :mod:`benchmarks.screen`.
+
 Solids: the mesh resolution (segments per circle, flank points per tooth) against
 closed forms and converged references, see :mod:`benchmarks.mesh_resolution`. Teeth
 (flank points against a simulated cut), DXF chord tolerance and the sweep tolerance,
@@ -229,6 +232,10 @@ def main(argv=None):
               "| rule | a (mm) | error (mm) | time (us) |", "|---|---:|---:|---:|"]
     for label, a, error, seconds in closure_rows:
         lines.append(f"| {label} | {a:.12f} | {error:.1e} | {seconds * 1e6:.0f} |")
+    from .screen import knob_markdown as screen_markdown, knob_rows as screen_rows
+
+    screen_knob = screen_rows(log=lambda line: print(line, flush=True))
+    lines += screen_markdown(screen_knob)
     pricking = pricking_table()
     lines += ["", "## Pricking mechanism: carrier grid of the tabulated pitch curves", "",
               "Forward check = largest distance between the type-value loop and the loop rebuilt "
@@ -264,6 +271,9 @@ def main(argv=None):
                                                   for row in segments],
         "sweep tolerance, arms (certified gap, mm)": [(row[5], row[6]) for row in sweeps
                                                       if row[0].startswith("arm")],
+        "population screen, samples/rev (per design, mm)": [
+            (row["cpu_us"] * 1e-6, max(row["errors"].values()))
+            for row in screen_knob["rows"] if not row["unresolved"]],
     }
     plot(series, figure)
     lines += ["", f"![error against time, every knob]({figure.name})", ""]

@@ -61,6 +61,18 @@ _EXPORTS = {
     "expand_grid": "cadgen.batch",
     "file_jobs": "cadgen.batch",
     "add_batch_arguments": "cadgen.batch",
+    # the optimiser: a study file's search, certified (cadgen optimize)
+    "Study": "cadgen.optimize.study",
+    "StudyError": "cadgen.optimize.study",
+    "load_study": "cadgen.optimize.study",
+    "DesignProblem": "cadgen.optimize.problem",
+    "make_problem": "cadgen.optimize.problem",
+    "optimize_study": "cadgen.optimize.run",
+    "OptimizeResult": "cadgen.optimize.run",
+    "OptimizeProgress": "cadgen.optimize.run",
+    "OptimizePrinter": "cadgen.optimize.progress",
+    "write_optimize_outputs": "cadgen.optimize.outputs",
+    "optimize_summary": "cadgen.optimize.outputs",
     # the studio: the design page in the browser (cadgen studio)
     "run_studio": "cadgen.studio.run",
     "StudioPortError": "cadgen.studio.run",

@@ -1,6 +1,7 @@
 """Command line: ``cadgen validate``, ``cadgen build`` (alias ``analyze``), ``cadgen batch``,
-``cadgen new`` (a starting parameter file), ``cadgen cache clear|info`` (the gear cache) and
-``cadgen studio`` (the design page in the browser).
+``cadgen optimize`` (search a study's free parameters), ``cadgen new`` (a starting
+parameter file), ``cadgen cache clear|info`` (the gear cache) and ``cadgen studio`` (the
+design page in the browser).
 
 Exit codes (every command):
 
@@ -139,6 +140,62 @@ def _cmd_build(args: argparse.Namespace) -> int:
     return result.exit_code
 
 
+def _whole_number(minimum: int):
+    """An argparse type: a whole number at least ``minimum`` (``--workers``, ``--seed``...)."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be at least {minimum}, got {value}")
+        return value
+
+    return parse
+
+
+def _cmd_optimize(args: argparse.Namespace) -> int:
+    """``cadgen optimize``: validate the study, search, certify, write; ``--build`` the best."""
+    import cadgen
+    from cadgen import StudyError, load_study
+
+    try:
+        study = load_study(args.study).with_budget(evaluations=args.evaluations, seed=args.seed)
+    except StudyError as exc:
+        for problem in exc.problems:
+            print(f"{args.study}: {problem}", file=sys.stderr)
+        return EXIT_PROBLEMS
+    from cadgen import OptimizePrinter
+
+    try:
+        with OptimizePrinter(sys.stderr) as printer:
+            result = cadgen.optimize_study(study, workers=args.workers,
+                                           scheduler=args.scheduler, progress=printer)
+    except cadgen.MechanismError as exc:   # the scheduler cannot be reached, say
+        print(f"cadgen optimize: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_PROBLEMS
+    folder = cadgen.write_optimize_outputs(result, Path(args.output_dir))
+    print(cadgen.optimize_summary(result, folder))
+    status = result.exit_code
+    if args.build and result.found:
+        from cadgen import ProgressPrinter
+
+        best = folder / "best.toml"
+        try:
+            with ProgressPrinter(sys.stderr) as printer:
+                built = cadgen.build(cadgen.load_params(best), output_root=Path(args.output_dir),
+                                     progress=printer)
+        except cadgen.MechanismError as exc:   # the build refused the design: it fails
+            for line in [str(p) for p in getattr(exc, "problems", ())] or [_one_line(exc)]:
+                print(f"{best}: {line}", file=sys.stderr)
+            return EXIT_CHECKS_FAILED
+        print(built.summary_text())
+        status = max(status, built.exit_code)
+    elif args.build:
+        print("--build: nothing built, no design met every target")
+    return status
+
+
 def _add_build_arguments(command: argparse.ArgumentParser) -> None:
     command.add_argument("file", metavar="FILE", help="TOML parameter file")
     command.add_argument("--output-dir", metavar="DIR", default="outputs",
@@ -231,6 +288,35 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
         from cadgen import add_batch_arguments
 
         add_batch_arguments(batch)
+
+    optimize = commands.add_parser(
+        "optimize", help="search a design's free parameters for one meeting every target",
+        description="Search the free parameters a study file names (within their bounds) for "
+        "the design meeting every target of the base file with the best objectives: a "
+        "vectorised screen over each population (pymoo: a GA for one objective, NSGA-II for "
+        "several; feasibility first), then the final designs re-evaluated by the exact "
+        "evaluator of 'cadgen build'. Writes OUTPUT_DIR/<name>/: best.toml (a commented "
+        "parameter file), optimize.html, optimize.json, convergence.png, and pareto.csv and "
+        "pareto.png for several objectives. Progress on stderr. Exit 0 when a design meeting "
+        "every target is found and certified, 1 when none is (the least-violating one is "
+        "written as least-violating.toml; with --build, also when the build misses a "
+        "target), 2 for a study file with problems (every one listed; nothing written), 3 on "
+        "an internal error.")
+    optimize.add_argument("study", metavar="STUDY", help="TOML study file")
+    optimize.add_argument("--workers", metavar="N", type=_whole_number(1), default=1,
+                          help="local processes screening each population (default: 1)")
+    optimize.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                          help="screen on a Dask cluster (tcp://host:8786) instead")
+    optimize.add_argument("--build", action="store_true",
+                          help="then build best.toml (every effect of its scene) into "
+                               "OUTPUT_DIR/<name>-best/ and print its summary")
+    optimize.add_argument("--output-dir", metavar="DIR", default="outputs",
+                          help="root of the output folders (default: %(default)s)")
+    optimize.add_argument("--evaluations", metavar="N", type=_whole_number(1), default=None,
+                          help="designs to screen, overriding [budget] evaluations")
+    optimize.add_argument("--seed", metavar="N", type=_whole_number(0), default=None,
+                          help="random seed, overriding [budget] seed")
+    optimize.set_defaults(handler=_cmd_optimize)
 
     new = commands.add_parser(
         "new", help="write a commented starting parameter file from a bundled design",

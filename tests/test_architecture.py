@@ -46,6 +46,13 @@ ALLOWED = {
     "cadgen.studio": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.cam",
                       "cadgen.solids", "cadgen.report", "cadgen.export", "cadgen.pipeline",
                       "cadgen.crash"},
+    # the optimiser: the planting screen (kinematics.population), the exact path (design,
+    # report's sections), the build's own checks (cam, machine, solids' housing rules, gears'
+    # circular sizing), and the studio's parameter schema and comment-keeping writer (one
+    # definition each: the study is validated as the form is, best.toml written as a save)
+    "cadgen.optimize": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.gears",
+                        "cadgen.cam", "cadgen.machine", "cadgen.solids", "cadgen.report",
+                        "cadgen.export", "cadgen.studio"},
     "cadgen.cli": {"cadgen", "cadgen.crash"},   # the command line uses the public API only
     "cadgen.__main__": {"cadgen.cli"},
     "cadgen": set(),                 # the API imports lazily, by name (see its _EXPORTS)

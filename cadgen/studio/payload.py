@@ -292,35 +292,26 @@ def problems_answer(problems, error: str | None = None) -> dict:
 def _margins(params, metrics: list) -> list:
     """How far each metric passes its target (its unit; negative: fails by that much).
 
-    From the file's targets, not from the target text: ``> m`` gives ``value - m``,
-    ``< M`` gives ``M - value``, ``lo-hi`` the nearer side, ``= k`` minus the distance.
-    Normalised by the bound's size (None where the bound is 0).
+    The one definition of a margin, :mod:`kinematics.margins` (the screen and the
+    optimiser use it too), from the file's targets. Normalised by the bound's size
+    (None where the bound is 0).
     """
-    targets = params.targets
-    bounds = {"trajectory_height": (targets.trajectory_height_min, None),
-              "hole_width": (0.0, targets.hole_width_max),
-              "hole_verticality": (None, targets.hole_verticality_max),
-              "angle_difference": (0.0, targets.angle_difference_max_deg),
-              "arm_distance": (targets.arm_distance_min, None),
-              "ground_clearance": (targets.ground_clearance_min, None),
-              "module": (targets.module_min, None),
-              "soil_penetrations": (1.0, 1.0)}
+    from kinematics.evaluation import Targets
+    from kinematics.margins import bounds_of, margins
+
+    targets = Targets(**params.targets.model_dump())
     out = []
     for metric in metrics:
-        low, high = bounds.get(metric["key"], (None, None))
+        low, high = bounds_of(metric["key"], targets)
         value = metric["value"]
-        margin = scale = None
+        margin = normalised = None
         if value is not None and (low is not None or high is not None):
-            sides = [(value - low, low) for _ in [0] if low is not None]
-            sides += [(high - value, high) for _ in [0] if high is not None]
-            if low is not None and high is not None and low == high:
-                sides = [(-abs(value - low), low)]
-            margin, bound = min(sides, key=lambda side: side[0])
-            scale = abs(high if high is not None else bound) or None
+            found, scale = margins(value, low, high)
+            margin = float(found)
+            if math.isfinite(margin) and math.isfinite(scale):
+                normalised = margin / scale
         out.append({"key": metric["key"], "spacing_mm": metric.get("spacing_mm"),
-                    "margin": margin,
-                    "margin_normalised": (margin / scale if margin is not None and scale
-                                          and math.isfinite(margin) else None)})
+                    "margin": margin, "margin_normalised": normalised})
     return out
 
 
