@@ -1,7 +1,8 @@
 """End to end: the real ``cadgen`` console script on every bundled example, as a user runs it.
 
-Files are found by glob (``params/*.toml``, ``params/grids/*.toml``), so a new example is
-covered without touching this file. Each run must end without a traceback and with exit
+Files are found by glob (``params/*.toml``, the studies' base designs
+``params/studies/bases/*.toml``, ``params/grids/*.toml``, ``params/studies/*.toml``), so a new
+example is covered without touching this file. Each run must end without a traceback and with exit
 0 or 1; what it prints and writes is checked against the input files themselves (read
 here with tomllib) and against report.json, not against the code that made them.
 """
@@ -24,7 +25,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PARAMS = sorted((ROOT / "params").glob("*.toml"))
+#: The studies' base designs: deliberately failing ones (the optimiser's starting points)
+STUDY_BASES = sorted((ROOT / "params" / "studies" / "bases").glob("*.toml"))
 GRIDS = sorted((ROOT / "params" / "grids").glob("*.toml"))
+STUDIES = sorted((ROOT / "params" / "studies").glob("*.toml"))
+#: A study's own budget is a real search (up to minutes for the pricking mechanism); here a
+#: small one (a part of the first generation), enough to run every stage of the command
+#: (screen, certify, write).
+STUDY_EVALUATIONS = 40
 CADGEN = Path(sys.executable).with_name("cadgen")
 TIMEOUT = 300
 
@@ -46,7 +54,7 @@ def toml(path: Path) -> dict:
 
 
 def test_examples_are_found():
-    assert len(PARAMS) >= 3 and len(GRIDS) >= 1
+    assert len(PARAMS) >= 3 and len(GRIDS) >= 1 and len(STUDIES) >= 3
     assert {p.name for p in PARAMS} >= {"xin2024-planter.toml", "kernel-a.toml", "kernel-b.toml"}
 
 
@@ -137,6 +145,50 @@ def _interrupt(args, delay: float, cwd: Path):
     os.killpg(process.pid, signal.SIGINT)
     _, stderr = process.communicate(timeout=TIMEOUT)
     return process.returncode, stderr, time.perf_counter() - signalled
+
+
+@pytest.mark.parametrize("file", STUDY_BASES, ids=[p.stem for p in STUDY_BASES])
+def test_study_bases_fail_cleanly(file, tmp_path):
+    # a base a study starts from misses its targets, or is refused by a build stage (its
+    # validate warning names it): either way one line per problem naming its field, never a
+    # traceback, and a refused build writes nothing
+    check = cadgen("validate", file, cwd=tmp_path)
+    no_traceback(check)
+    assert check.returncode == 0, check.stdout + check.stderr
+    warnings = [line for line in check.stdout.splitlines() if ": warning: " in line]
+    result = cadgen("build", file, "--output-dir", tmp_path / "out", cwd=tmp_path)
+    no_traceback(result)
+    if result.returncode == 2:
+        assert warnings, "a build refused a file validate found nothing wrong with"
+        refused = result.stderr.strip().splitlines()
+        assert refused and all(line.startswith(f"{file}: ") for line in refused)
+        assert {line.split(": ", 1)[1] for line in refused} <= {
+            line.split(": warning: ", 1)[1] for line in warnings}
+        assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
+    else:
+        assert result.returncode == 1, result.stdout[-2000:] + result.stderr[-2000:]
+
+
+@pytest.mark.parametrize("study", STUDIES, ids=[s.stem for s in STUDIES])
+def test_optimize_every_study(study, tmp_path):
+    name = toml(study)["name"]
+    result = cadgen("optimize", study, "--evaluations", STUDY_EVALUATIONS, "--workers", 2,
+                    "--output-dir", tmp_path / "out", cwd=tmp_path)
+    no_traceback(result)
+    assert result.returncode in (0, 1), result.stdout[-2000:] + result.stderr[-2000:]
+    folder = tmp_path / "out" / name
+    summary = json.loads((folder / "optimize.json").read_text(encoding="utf-8"))
+    # exit 0 exactly when a design meeting every target was found: then best.toml, else the
+    # least-violating design; either is a parameter file that validates
+    assert summary["found"] == (result.returncode == 0) and summary["exit_code"] == result.returncode
+    written = folder / ("best.toml" if result.returncode == 0 else "least-violating.toml")
+    assert summary["best_file"] == written.name
+    assert written.is_file() and (folder / "optimize.html").is_file()
+    assert not (folder / ("least-violating.toml" if result.returncode == 0 else "best.toml")).exists()
+    assert summary["search"]["evaluations"] == STUDY_EVALUATIONS
+    check = cadgen("validate", written, cwd=tmp_path)
+    no_traceback(check)
+    assert check.returncode == 0, check.stdout + check.stderr
 
 
 @pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX)")
