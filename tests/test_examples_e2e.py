@@ -147,6 +147,20 @@ def _interrupt(args, delay: float, cwd: Path):
     return process.returncode, stderr, time.perf_counter() - signalled
 
 
+@pytest.mark.parametrize("file", GRIDS + STUDIES, ids=[p.stem for p in GRIDS + STUDIES])
+def test_build_on_a_grid_or_study_file_names_the_command_that_reads_it(file, tmp_path):
+    # a user pointing `cadgen build` at the wrong kind of bundled file is told which command
+    # reads it, from the file's own tables, not that `mechanism` is missing
+    result = cadgen("build", file, "--output-dir", tmp_path / "out", cwd=tmp_path)
+    no_traceback(result)
+    assert result.returncode == 2 and not (tmp_path / "out").exists()
+    command = "cadgen batch --grid FILE" if "grid" in toml(file) else "cadgen optimize FILE"
+    assert result.stderr.strip().splitlines() == [
+        f"{file}: <file>: this is a {'grid' if 'grid' in toml(file) else 'study'} file (a base "
+        f"design and [{'grid' if 'grid' in toml(file) else 'free'}]), not a parameter file: "
+        f"run `{command}` [not_a_parameter_file]"]
+
+
 @pytest.mark.parametrize("file", STUDY_BASES, ids=[p.stem for p in STUDY_BASES])
 def test_study_bases_fail_cleanly(file, tmp_path):
     # a base a study starts from misses its targets, or is refused by a build stage (its
