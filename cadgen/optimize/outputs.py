@@ -192,6 +192,12 @@ def convergence_png(result) -> bytes:
     top.grid(alpha=0.3)
     bottom.plot(evaluations, violation, marker=".", color="tab:red")
     bottom.set_yscale("symlog", linthresh=1e-4)
+    # plain tick labels (1e-04): the default ones are mathtext powers whose superscript minus
+    # makes matplotlib hunt fallback fonts, one warning line each on the user's terminal
+    from matplotlib.ticker import FuncFormatter
+
+    bottom.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:.0e}" if value
+                                                   else "0"))
     finite = violation[np.isfinite(violation)]
     bottom.set_ylim(bottom=0.0, top=max(1e-3, 2.0 * float(finite.max(initial=0.0))))
     bottom.set_ylabel("smallest constraint\nviolation (sum of G > 0)")
