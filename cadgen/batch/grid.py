@@ -18,11 +18,10 @@ from __future__ import annotations
 
 import copy
 import itertools
-import json
 import math
 import os
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -30,6 +29,8 @@ from typing import Any
 from kinematics.errors import DesignError, Problem
 
 from cadgen.batch.summary import SUMMARY_CSV, SUMMARY_HTML
+from cadgen.params.side_files import assign_dotted as _assign, flatten_dotted, read_toml_file
+from cadgen.params.side_files import is_number as _is_number, show as _show
 
 __all__ = ["DesignJob", "GridError", "file_jobs", "expand_grid", "guard_names"]
 
@@ -77,7 +78,7 @@ class GridError(DesignError):
 
 def _peek_name(path: Path) -> str:
     """The ``name`` a parameter file gives, without validating it; else the file's stem."""
-    name = (_read_toml(path, "")[0] or {}).get("name")
+    name = (read_toml_file(path, "")[0] or {}).get("name")
     return name if isinstance(name, str) and name else path.stem
 
 
@@ -137,42 +138,6 @@ def guard_names(jobs: Sequence[DesignJob]) -> list[DesignJob]:
 # --------------------------------------------------------------------------- grid files
 
 
-def _read_toml(path: Path, where: str) -> tuple[dict | None, list[Problem]]:
-    """Parse a TOML file; problems at ``where`` if it cannot be read or parsed."""
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except FileNotFoundError:
-        return None, [Problem(where, "file_not_found", f"no such file: {path}")]
-    except UnicodeDecodeError:
-        return None, [Problem(where, "not_utf8", f"{path} is not UTF-8 text")]
-    except OSError as exc:
-        return None, [Problem(where, "not_readable", f"cannot read {path}: {exc.strerror}")]
-    from cadgen.params.loading import ParameterError, parse_toml
-
-    try:
-        return parse_toml(text), []
-    except ParameterError as error:   # syntax, nesting too deep, an integer too long
-        return None, [Problem(where, p.code, f"{path}: {p.message}") for p in error.problems]
-
-
-def _show(value: Any) -> str:
-    return json.dumps(value) if isinstance(value, str) else repr(value)
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _flatten(table: Mapping, prefix: str = "") -> Iterable[tuple[str, Any]]:
-    """``(dotted key, spec)`` of a ``[grid]`` table; TOML dotted keys make nested tables."""
-    for key, value in table.items():
-        dotted = f"{prefix}.{key}" if prefix else str(key)
-        if isinstance(value, dict) and not any(k in value for k in _RANGE_KEYS):
-            yield from _flatten(value, dotted)
-        else:
-            yield dotted, value
-
-
 def _linspace(start: float, stop: float, num: int) -> list:
     """``num`` evenly spaced values from ``start`` to ``stop`` inclusive, endpoints exact.
 
@@ -217,20 +182,6 @@ def _axis_values(key: str, spec: Any) -> tuple[list | None, list[Problem]]:
     return _linspace(spec["start"], spec["stop"], num), []
 
 
-def _assign(data: dict, key: str, value: Any) -> str | None:
-    """Set the dotted ``key`` in ``data`` (making missing tables); a reason if it cannot."""
-    parts = key.split(".")
-    node = data
-    for depth, part in enumerate(parts[:-1]):
-        child = node.setdefault(part, {})
-        if not isinstance(child, dict):
-            table = ".".join(parts[: depth + 1])
-            return f"{table} is not a table in the base file, so {key} cannot be set"
-        node = child
-    node[parts[-1]] = value
-    return None
-
-
 def _related(path: str, key: str) -> bool:
     """Is a problem at ``path`` about the grid ``key`` (the key, inside it, or a parent)?"""
     return path == key or path.startswith(key + ".") or key.startswith(path + ".")
@@ -266,7 +217,7 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
 
     grid_path = Path(grid_file)
     source = str(grid_file)
-    grid, problems = _read_toml(grid_path, "")
+    grid, _, problems = read_toml_file(grid_path, "")
     if grid is None:
         raise GridError(problems, source)
     problems += [Problem(str(k), "unknown_key", f"unknown key '{k}' at the top level of the grid "
@@ -275,7 +226,7 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
 
     base, base_data = grid.get("base"), None
     if isinstance(base, str):
-        base_data, found = _read_toml(grid_path.parent / base, "base")
+        base_data, _, found = read_toml_file(grid_path.parent / base, "base")
         problems += found
     else:
         problems.append(Problem("base", "missing", "required key 'base' (the parameter file the "
@@ -291,7 +242,7 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
         problems.append(Problem("grid", "wrong_type", f"grid must be a table, not {_show(table)}"))
     else:
         seen = set()
-        for key, spec in _flatten(table):
+        for key, spec in flatten_dotted(table, _RANGE_KEYS):
             if key in seen:
                 problems.append(Problem(f"grid.{key}", "duplicate", f"{key} is given twice"))
                 continue

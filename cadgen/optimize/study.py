@@ -34,11 +34,9 @@ from __future__ import annotations
 
 import copy
 import difflib
-import json
 import math
 import os
 import re
-from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -46,6 +44,8 @@ from typing import Any
 from kinematics.errors import Problem
 
 from cadgen.params.loading import ParameterError
+from cadgen.params.side_files import assign_dotted as _assign, flatten_dotted, read_toml_file
+from cadgen.params.side_files import is_number as _is_number, show as _show
 
 __all__ = ["Study", "StudyError", "load_study", "STUDY_KEYS", "DEFAULT_EVALUATIONS",
            "DEFAULT_SEED", "MAX_EVALUATIONS"]
@@ -126,14 +126,6 @@ class Study:
 # --------------------------------------------------------------------------- helpers
 
 
-def _show(value: Any) -> str:
-    return json.dumps(value) if isinstance(value, str) else repr(value)
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
 def _whole(value: Any, low: int) -> bool:
     return (isinstance(value, int) and not isinstance(value, bool)
             and low <= value <= MAX_EVALUATIONS)
@@ -143,51 +135,12 @@ def _free_field(path: str) -> str:
     return f'free."{path}"'
 
 
-def _read_toml(path: Path, where: str) -> tuple[dict | None, str, list[Problem]]:
-    """Parse a TOML file: ``(data, text, problems at where)``."""
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except FileNotFoundError:
-        return None, "", [Problem(where, "file_not_found", f"no such file: {path}")]
-    except IsADirectoryError:
-        return None, "", [Problem(where, "not_readable", f"{path} is a directory")]
-    except UnicodeDecodeError:
-        return None, "", [Problem(where, "not_utf8", f"{path} is not UTF-8 text")]
-    except OSError as exc:
-        return None, "", [Problem(where, "not_readable", f"cannot read {path}: {exc.strerror}")]
-    from cadgen.params.loading import parse_toml
-
-    try:
-        return parse_toml(text), text, []
-    except ParameterError as error:
-        return None, text, [Problem(where, p.code, f"{path}: {p.message}")
-                            for p in error.problems]
-
-
-def _flatten(table: Mapping, prefix: str = "") -> Iterable[tuple[str, Any]]:
-    """``(dotted path, spec)`` of ``[free]``; TOML dotted keys make nested tables."""
-    for key, value in table.items():
-        dotted = f"{prefix}.{key}" if prefix else str(key)
-        if isinstance(value, dict) and not any(k in value for k in _BOX_KEYS):
-            yield from _flatten(value, dotted)
-        else:
-            yield dotted, value
-
-
 def _numeric_fields(kind: str) -> dict:
     """``{path: schema entry}`` of every field of the kind (the studio's schema)."""
     from cadgen.studio.schema import studio_schema
 
     tables = studio_schema()["kinds"][kind]["tables"]
     return {field["path"]: field for table in tables for field in table["fields"]}
-
-
-def _assign(data: dict, path: str, value: Any) -> None:
-    node = data
-    parts = path.split(".")
-    for part in parts[:-1]:
-        node = node.setdefault(part, {})
-    node[parts[-1]] = value
 
 
 def _related(problem_path: str, path: str) -> bool:
@@ -372,7 +325,7 @@ def load_study(path: str | os.PathLike) -> Study:
 
     study_path = Path(path)
     source = str(path)
-    data, text, problems = _read_toml(study_path, "")
+    data, text, problems = read_toml_file(study_path, "")
     if data is None:
         raise StudyError(problems, source)
     problems += [Problem(str(k), "unknown_key", f"unknown key '{k}' at the top level of the "
@@ -383,7 +336,7 @@ def load_study(path: str | os.PathLike) -> Study:
     base, base_data, base_params, base_path = data.get("base"), None, None, None
     if isinstance(base, str) and base:
         base_path = (study_path.parent / base).resolve()
-        base_data, _, found = _read_toml(base_path, "base")
+        base_data, _, found = read_toml_file(base_path, "base")
         problems += found
         if base_data is not None:
             try:
@@ -419,7 +372,7 @@ def load_study(path: str | os.PathLike) -> Study:
     elif not table:
         problems.append(Problem("free", "empty", "[free] names no parameter to search"))
     elif kind == "pricking":
-        for key, spec in _flatten(table):
+        for key, spec in flatten_dotted(table, _BOX_KEYS):
             if key != POINTS_PATH:
                 problems.append(Problem(_free_field(key), "not_allowed", f"a pricking study "
                                         f"moves {POINTS_PATH} only, not {key}"))
@@ -430,7 +383,7 @@ def load_study(path: str | os.PathLike) -> Study:
         fields, free = _numeric_fields(kind), []
         supported = getattr(problem_class(kind), "supported_paths", None)
         supported = None if supported is None else list(supported(base_params))
-        for key, spec in _flatten(table):
+        for key, spec in flatten_dotted(table, _BOX_KEYS):
             found = _check_path(key, fields, kind)
             if not found and supported is not None and key not in supported:
                 found = [Problem(_free_field(key), "not_supported", f"{key} cannot be searched: "
