@@ -10,13 +10,10 @@ another tenth of the budget, and one per certified design, nothing redrawn.
 
 from __future__ import annotations
 
-import sys
-
-from cadgen.report.progress import progress_bar
+from cadgen.report.progress import StatusPrinter, progress_bar
 
 __all__ = ["OptimizePrinter", "describe_progress"]
 
-_CLEAR = "\r\x1b[K"
 #: Plain lines (a pipe) while screening: one each time another 1/PLAIN_STEPS of the budget is done.
 PLAIN_STEPS = 10
 
@@ -35,7 +32,7 @@ def describe_progress(event) -> str:
             f"{event.budget} evaluations, generation {event.generation}, {state}")
 
 
-class OptimizePrinter:
+class OptimizePrinter(StatusPrinter):
     """Print a study's progress (a callable: ``printer(event)``); :meth:`close` at the end.
 
     Parameters
@@ -46,33 +43,16 @@ class OptimizePrinter:
     """
 
     def __init__(self, stream=None, tty: bool | None = None):
-        self.stream = sys.stderr if stream is None else stream
-        self.tty = bool(tty if tty is not None else getattr(self.stream, "isatty", bool)())
-        self._shown = False
+        super().__init__(stream, tty)
         self._next_plain = 0     # the next step (of PLAIN_STEPS) that earns a plain line
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc_info):
-        self.close()
-        return False
 
     def __call__(self, event) -> None:
         line = describe_progress(event)
         if self.tty:
-            self.stream.write(_CLEAR + line + f" {event.elapsed:.1f} s")
-            self._shown = True
+            self._status(line + f" {event.elapsed:.1f} s")
         elif event.stage != "screen" or event.evaluations >= event.budget or (
                 event.evaluations * PLAIN_STEPS >= self._next_plain * event.budget):
             if event.stage == "screen":
                 self._next_plain = event.evaluations * PLAIN_STEPS // event.budget + 1
             self.stream.write(f"[{event.elapsed:6.1f} s] {line}\n")
         self.stream.flush()
-
-    def close(self) -> None:
-        """Clear the status line (a terminal); safe to call twice."""
-        if self.tty and self._shown:
-            self.stream.write(_CLEAR)
-            self.stream.flush()
-            self._shown = False

@@ -15,7 +15,7 @@ import sys
 import threading
 import time
 
-__all__ = ["ProgressPrinter", "progress_bar"]
+__all__ = ["ProgressPrinter", "StatusPrinter", "progress_bar"]
 
 #: Width of a stage's bar on the status line, in characters.
 BAR_WIDTH = 16
@@ -30,12 +30,9 @@ def progress_bar(done: int, total: int, width: int = BAR_WIDTH) -> str:
     return "[" + "#" * filled + "-" * (width - filled) + "]"
 
 
-def _name(event) -> str:
-    return event.stage + (" (beside)" if event.beside else "")
-
-
-class ProgressPrinter:
-    """Print a build's progress events (a callable: ``printer(event)``); :meth:`close` at the end.
+class StatusPrinter:
+    """What every progress printer shares: the stream, whether it is a terminal (redraw one
+    status line in place) or not (plain lines), use as a context manager, clearing the line.
 
     Parameters
     ----------
@@ -47,11 +44,7 @@ class ProgressPrinter:
     def __init__(self, stream=None, tty: bool | None = None):
         self.stream = sys.stderr if stream is None else stream
         self.tty = bool(tty if tty is not None else getattr(self.stream, "isatty", bool)())
-        self._running: dict = {}     # (stage, beside) -> [start, done, steps, detail]
-        self._lock = threading.Lock()
-        self._shown = False
-        self._stop = threading.Event()
-        self._ticker = None
+        self._shown = False      # a status line is on the terminal, to clear
 
     def __enter__(self):
         return self
@@ -59,6 +52,43 @@ class ProgressPrinter:
     def __exit__(self, *exc_info):
         self.close()
         return False
+
+    def _status(self, line: str) -> None:
+        """Redraw the status line (a terminal) with ``line``."""
+        self.stream.write(_CLEAR + line)
+        self._shown = True
+
+    def _clear_status(self) -> None:
+        if self.tty and self._shown:
+            self.stream.write(_CLEAR)
+            self.stream.flush()
+            self._shown = False
+
+    def close(self) -> None:
+        """Clear the status line (a terminal); safe to call twice."""
+        self._clear_status()
+
+
+def _name(event) -> str:
+    return event.stage + (" (beside)" if event.beside else "")
+
+
+class ProgressPrinter(StatusPrinter):
+    """Print a build's progress events (a callable: ``printer(event)``); :meth:`close` at the end.
+
+    Parameters
+    ----------
+    stream : text stream, default sys.stderr
+    tty : bool, optional
+        Redraw in place (default: ``stream.isatty()``); False prints plain lines.
+    """
+
+    def __init__(self, stream=None, tty: bool | None = None):
+        super().__init__(stream, tty)
+        self._running: dict = {}     # (stage, beside) -> [start, done, steps, detail]
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._ticker = None
 
     # ------------------------------------------------------------------ events
     def __call__(self, event) -> None:
@@ -137,10 +167,7 @@ class ProgressPrinter:
             self._ticker.join()
             self._ticker = None
         with self._lock:
-            if self.tty and self._shown:
-                self.stream.write(_CLEAR)
-                self.stream.flush()
-                self._shown = False
+            self._clear_status()
 
 
 def _first_line(text: str, limit: int = 160) -> str:
