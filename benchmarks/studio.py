@@ -17,7 +17,7 @@ Three figures per request: **wall**, the time of the request through the app;
 worker thread), which the other processes on the machine do not inflate; and the
 evaluation's own ``elapsed_ms`` (validation to payload, before JSON encoding). Three
 warm-up requests per kind are not counted. numpy's BLAS runs on one thread, as in
-``cadgen studio`` (:func:`cadgen.studio.run.single_threaded_math`). The aims (issue
+``cadgen studio`` (:func:`cadgen.math_threads.single_threaded_math`). The aims (issue
 16): p95 <= 100 ms for the planting mechanism, <= 500 ms for the pricking inverse design.
 """
 
@@ -124,7 +124,7 @@ def main(argv=None) -> None:
                         help="counted requests per mechanism kind (default 50)")
     args = parser.parse_args(argv)
     warnings.filterwarnings("ignore", category=DeprecationWarning)
-    from cadgen.studio.run import single_threaded_math
+    from cadgen.math_threads import single_threaded_math
 
     single_threaded_math()   # as `cadgen studio` runs: before numpy loads
     from fastapi.testclient import TestClient

@@ -529,6 +529,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         command line) raise SystemExit as usual.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
+    from cadgen.math_threads import one_thread_for_commands
+
+    one_thread_for_commands()   # before numpy loads (see cadgen.math_threads)
     with _Interrupts() as interrupts:
         try:
             args = build_parser(argv).parse_args(argv)

@@ -8,12 +8,13 @@ from functools import lru_cache
 import numpy as np
 
 from kinematics.evaluation import Targets, evaluate_planting
+from kinematics.metrics import plant_events
 from kinematics.pitch_curves import LimaconPitchCurve
 from kinematics.planting import PlantingMechanism
 
 from cadgen.solids.housings import housing_circles
 
-__all__ = ["build_mechanism", "targets_of", "evaluate", "pricking_design",
+__all__ = ["build_mechanism", "planting_events", "targets_of", "evaluate", "pricking_design",
            "pricking_field"]
 
 
@@ -36,6 +37,15 @@ def build_mechanism(params) -> PlantingMechanism:
         closure_rtol=params.resolution.closure_rtol)
 
 
+@lru_cache(maxsize=16)
+def planting_events(mechanism: PlantingMechanism, depth: float, steps: int):
+    """The tip's plant events (lowest point, soil line, entry and exit) at ``depth`` mm,
+    searched with ``steps`` samples a turn (:func:`kinematics.metrics.plant_events`; raises
+    its ``NoSoilCrossingError``). Cached: validation's feasibility checks and the build's
+    metrics share them."""
+    return plant_events(mechanism.tip_path(), depth, steps=steps)
+
+
 def targets_of(params) -> Targets:
     return Targets(**params.targets.model_dump())
 
@@ -53,12 +63,13 @@ def evaluate(params, mechanism: PlantingMechanism | None = None, steps: int | No
         return pricking_design(params)
     mechanism = mechanism or build_mechanism(params)
     teeth = params.pitch_curve.teeth
+    steps = steps or params.resolution.steps_per_revolution
     return evaluate_planting(
         mechanism, teeth=teeth, depth=params.field.depth, spacings=params.field.plant_spacings,
         carrier_speed_rpm=params.field.carrier_speed_rpm,
         housing_circles=housing_circles(params, mechanism),
-        targets=targets_of(params),
-        steps=steps or params.resolution.steps_per_revolution)
+        targets=targets_of(params), steps=steps,
+        events=planting_events(mechanism, params.field.depth, steps))
 
 
 @lru_cache(maxsize=16)

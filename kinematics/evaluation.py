@@ -98,7 +98,8 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
                       spacings, housing_circles, carrier_speed_rpm: float = 30.0,
                       targets: Targets = Targets(),
                       steps: int = tol.STEPS_PER_REVOLUTION,
-                      clearance_model=None) -> PlantingEvaluation:
+                      clearance_model=None, events: PlantEvents | None = None
+                      ) -> PlantingEvaluation:
     """Evaluate every design metric of the planting mechanism.
 
     Parameters
@@ -121,13 +122,16 @@ def evaluate_planting(mechanism: PlantingMechanism, *, teeth: int, depth: float,
         Supplies ``arm_distance`` and ``ground_clearance`` (see
         :class:`~kinematics.clearance.KinematicClearance`, the default, built
         on ``housing_circles``).
+    events : PlantEvents, optional
+        ``plant_events(mechanism.tip_path(), depth, steps=steps)`` when the caller has them
+        already (validation computed them).
     """
     omega = 2.0 * np.pi * carrier_speed_rpm / 60.0
     closure = mechanism.closure
     perimeter = mechanism.pitch_perimeter
     module = mechanism.module(teeth)
     tip = mechanism.tip_path()
-    events = plant_events(tip, depth, steps=steps)
+    events = events or plant_events(tip, depth, steps=steps)
     holes = [hole_metrics(tip, events, float(s), steps=steps) for s in spacings]
     circles = list(housing_circles)
     model = clearance_model or KinematicClearance(tuple(circles))

@@ -21,6 +21,7 @@ REPO = Path(__file__).resolve().parents[1]
 ALLOWED = {
     "kinematics": set(),
     "cadgen.crash": {"cadgen"},      # a bug's one line and crash file (cli, studio)
+    "cadgen.math_threads": set(),    # one math thread for the commands and the studio
     "cadgen.geometry": set(),
     # loading calls the design checks, inside a function (see cadgen.params.feasibility)
     "cadgen.params": {"kinematics", "cadgen.params.feasibility"},
@@ -45,7 +46,7 @@ ALLOWED = {
     # the evaluation's sections as report.json holds them, and the build's stage plan
     "cadgen.studio": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.cam",
                       "cadgen.solids", "cadgen.report", "cadgen.export", "cadgen.pipeline",
-                      "cadgen.crash"},
+                      "cadgen.crash", "cadgen.math_threads"},
     # the optimiser: the planting screen (kinematics.population), the exact path (design,
     # report's sections), the build's own checks (cam, machine, solids' housing rules, gears'
     # circular sizing), and the studio's parameter schema and comment-keeping writer (one
@@ -53,7 +54,8 @@ ALLOWED = {
     "cadgen.optimize": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.gears",
                         "cadgen.cam", "cadgen.machine", "cadgen.solids", "cadgen.report",
                         "cadgen.export", "cadgen.studio"},
-    "cadgen.cli": {"cadgen", "cadgen.crash"},   # the command line uses the public API only
+    # the command line uses the public API only (and the two helpers it shares with the studio)
+    "cadgen.cli": {"cadgen", "cadgen.crash", "cadgen.math_threads"},
     "cadgen.__main__": {"cadgen.cli"},
     "cadgen": set(),                 # the API imports lazily, by name (see its _EXPORTS)
 }

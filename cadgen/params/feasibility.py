@@ -9,7 +9,6 @@ from __future__ import annotations
 import dataclasses
 
 from kinematics.errors import ConvergenceError, DesignError, Problem
-from kinematics.metrics import vertical_extremes
 from kinematics.pitch_curves import pair_problems
 
 __all__ = ["design_problems", "CAM_STAGE"]
@@ -51,23 +50,22 @@ def design_problems(params) -> list:
     problems = pair_problems(closure, module)
     if problems:
         return problems
-    lowest, highest = vertical_extremes(mechanism.tip_path(),
-                                        steps=params.resolution.steps_per_revolution)
-    height = -highest.value - lowest.value
-    if params.field.depth >= height:
-        problems.append(Problem(
-            "field.depth", "no_soil_crossing",
-            f"planting depth {params.field.depth:g} mm is not less than the tip path's height "
-            f"{height:.3f} mm: the tip never leaves the soil"))
-        return problems
-    return _cam_problems(params, mechanism)
+    from cadgen.design import planting_events
+
+    try:
+        # the metrics' own events (cached): a depth the tip path never leaves is refused
+        # here, with the tip path's height
+        events = planting_events(mechanism, params.field.depth,
+                                 params.resolution.steps_per_revolution)
+    except DesignError as error:   # no events: no cam timing to check
+        return list(error.problems) + _cam_problems(params, mechanism, None)
+    return _cam_problems(params, mechanism, events)
 
 
-def _cam_problems(params, mechanism) -> list:
-    """The duckbill linkage and the cam's timing, in the cam stage (checks of the contour
-    itself are reported, not refused: a designer wants to see the cam that fails)."""
-    from kinematics.metrics import plant_events
-
+def _cam_problems(params, mechanism, events) -> list:
+    """The duckbill linkage and (given the plant ``events``) the cam's timing, in the cam
+    stage (checks of the contour itself are reported, not refused: a designer wants to see
+    the cam that fails)."""
     from cadgen.cam.design import linkage_of, timing_of
 
     problems = []
@@ -75,12 +73,8 @@ def _cam_problems(params, mechanism) -> list:
         linkage_of(params)
     except DesignError as error:
         problems += _in_stage(error.problems, CAM_STAGE)
-    try:
-        # the events are the metrics' own: a problem finding them is no cam problem
-        events = plant_events(mechanism.tip_path(), params.field.depth,
-                              steps=params.resolution.steps_per_revolution)
-    except DesignError as error:
-        return problems + list(error.problems)
+    if events is None:
+        return problems
     try:
         timing_of(params, mechanism, events)
     except DesignError as error:

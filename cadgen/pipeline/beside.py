@@ -4,10 +4,12 @@ show no gear, while the building process cuts the gears.
 On a machine with a second core and the fork start method, :func:`start_beside` forks one
 worker when the teeth stage begins. The worker inherits every value computed so far (nothing
 is pickled on the way in), builds the gearless parts, runs the FCL sweeps on them (only where
-the housings do not depend on the gears: the assembly module's ``GEARLESS_KINDS``), then draws every
-figure that shows no gear; its results come back pickled (sweep records and values, PNG
-bytes). The building process cuts the teeth, builds the parts with the gears, draws the
-figures that show gears (:func:`plots_beside`) and then collects the worker's
+the housings do not depend on the gears: the assembly module's ``GEARLESS_KINDS``), then
+draws figures that show no gear; its results come back pickled (sweep records and values,
+PNG bytes). The building process cuts the teeth, builds the parts with the gears, draws the
+assembly view (:func:`plots_beside`), then shares the rest: the worker's gearless figures and
+the gear pairs' are taken one at a time from counters both processes hold, whoever is free
+first, so neither waits on the other's last figures; then it collects the worker's results
 (:func:`collect`). What is computed is the same either way, file for file
 (tests/test_beside.py); its progress events are relayed through a pipe
 (:class:`cadgen.pipeline.progress.StageProgress`), marked ``beside``.
@@ -45,6 +47,8 @@ class _Beside:
     figures: object         # future: {"figures": ..., "seconds": ...}
     sweeps: tuple
     taken: object           # shared counter: the next gear pair's figure to draw, either side
+    figure_pool: object     # shared counter: the next gearless figure to draw, either side
+    pool_key: object        # shared: the worker's list of those figures (its crc32), -1 before
     pairs: object = None    # future of the last task: {"figures": ..., "seconds": ...}
 
     def finish(self, pairs: dict | None = None):
@@ -93,19 +97,20 @@ def start_beside(run, functions):
 
         preload()
     ends = run.progress.pipe()
-    taken = multiprocessing.get_context("fork").Value("i", 0)
+    context = multiprocessing.get_context("fork")
+    taken, pool, pool_key = context.Value("i", 0), context.Value("i", 0), context.Value("q", -1)
     _BESIDE.update(run=run, functions=functions, sweeps=sweeps, figures=figures,
-                   events=ends[1] if ends else None, taken=taken)
-    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
+                   events=ends[1] if ends else None, taken=taken, pool=pool, pool_key=pool_key)
+    executor = ProcessPoolExecutor(1, mp_context=context)
     try:
-        solids = pool.submit(_beside_solids)   # forks the worker here
-        figures = pool.submit(_beside_figures)  # the same worker, after the first task
+        solids = executor.submit(_beside_solids)   # forks the worker here
+        figures = executor.submit(_beside_figures)  # the same worker, after the first task
     finally:
         _BESIDE.clear()             # the forked worker has its own copy
         if ends:
             run.progress.relay(ends[0])
             ends[1].close()         # the worker's copy is the last: its end is the relay's
-    return _Beside(pool, solids, figures, sweeps, taken)
+    return _Beside(executor, solids, figures, sweeps, taken, pool, pool_key)
 
 
 def _beside_solids() -> dict:
@@ -159,9 +164,10 @@ def _beside_solids() -> dict:
 
 
 def _beside_figures() -> dict:
-    """In the forked worker, second: the figures that show no gear.
-
-    ``{"figures": {name: PNG bytes}, "seconds": float}``.
+    """In the forked worker, second: the figures that show no gear, the pooled ones
+    (:func:`pooled_figures`) taken one at a time with the building process, which joins in
+    once its own parts and assembly view are done; then the clearance figure (only this side
+    has the sweeps). ``{"figures": {name: PNG bytes}, "seconds": float}``.
     """
     run, progress = _BESIDE["run"], _BESIDE["run"].progress
     if _BESIDE.get("failed"):
@@ -173,15 +179,60 @@ def _beside_figures() -> dict:
 
             jobs = {name: draw for name, draw in figure_jobs(run).items()
                     if not _shows_gears(name)}
-            progress.started("plots", steps=len(jobs), detail="figures", beside=True)
-            for name, draw in jobs.items():
-                figures[name] = draw()
-                progress.step("plots", name, beside=True)
+            # how many this side draws is known only at the end (steps 0: not known)
+            progress.started("plots", detail="figures", beside=True)
+            pooled = pooled_figures(jobs)
+            _BESIDE["pool_key"].value = _list_key(pooled)
+            while (index := _take(_BESIDE["pool"], len(pooled))) is not None:
+                figures[pooled[index]] = jobs[pooled[index]]()
+                progress.step("plots", pooled[index], steps=0, beside=True)
+            for name in jobs.keys() - set(pooled):
+                figures[name] = jobs[name]()
+                progress.step("plots", name, steps=0, beside=True)
         _BESIDE["drawn"] = time.perf_counter() - start
         return {"figures": figures, "seconds": time.perf_counter() - start}
     except BaseException:
         _BESIDE["failed"] = True
+        _BESIDE["pool_key"].value = -1     # the building process draws what is left
         raise
+
+
+#: Drawing time of the gearless figures that take longest (CPU seconds, paper design): they
+#: go first in the pool, so the short ones even out the two processes' ends.
+_SLOW_FIGURES = {"cam-follower.png": 0.11, "housing-gearbox1.png": 0.11,
+                 "housing-gearbox2.png": 0.10, "housing.png": 0.10}
+
+
+def pooled_figures(jobs) -> list:
+    """The gearless figures either process may draw, slowest first: every figure of
+    ``jobs`` but the gear pairs', the assembly view and the clearance figure (the sweeps'
+    results are the worker's until collected). Both processes list them from their own
+    runs; they share the pool only when the lists agree (:func:`_list_key`)."""
+    names = [name for name in jobs if not _shows_gears(name) and name != "clearance.png"]
+    return sorted(names, key=lambda name: -_SLOW_FIGURES.get(name, 0.0))
+
+
+def _list_key(names) -> int:
+    """A number naming a list of figures (crc32 of the names, in order)."""
+    import zlib
+
+    return zlib.crc32("\n".join(names).encode())
+
+
+def _draw_pooled(run, beside, drawn) -> dict:
+    """Here, the pooled figures the worker has not taken yet, when it has listed the same
+    figures as this process (else none: the worker draws them all)."""
+    from cadgen.pipeline.figures import figure_jobs
+
+    jobs = figure_jobs(run)
+    pooled = pooled_figures(jobs)
+    if not pooled or beside.pool_key.value != _list_key(pooled):
+        return {}
+    figures = {}
+    while (index := _take(beside.figure_pool, len(pooled))) is not None:
+        figures[pooled[index]] = jobs[pooled[index]]()
+        drawn(pooled[index])
+    return figures
 
 
 def _beside_pairs(pairs: dict) -> dict:
@@ -289,13 +340,20 @@ def plots_beside(run, beside):
     for name, draw in jobs.items():
         mine[name] = draw()
         run.progress.step("plots", name)
+    step = lambda name: run.progress.step("plots", name)   # noqa: E731
+    mine.update(_draw_pooled(run, beside, step))
     seconds = time.perf_counter() - start
     if not beside.done():   # while the worker finishes: what the writing will need
         from cadgen.pipeline.writers import prepare
 
+        if beside.pool_key.value == -1:   # the worker still sweeps: join its figures after
+            prepare(run, lambda: beside.done() or beside.pool_key.value != -1)
+            begun = time.perf_counter()
+            mine.update(_draw_pooled(run, beside, step))
+            seconds += time.perf_counter() - begun
         prepare(run, beside.done)
     begun = time.perf_counter()   # then the pairs' figures the worker has not taken yet
-    mine.update(_draw_taken(pairs, beside.taken, lambda name: run.progress.step("plots", name)))
+    mine.update(_draw_taken(pairs, beside.taken, step))
     seconds += time.perf_counter() - begun
     outcome = collect(run, beside)
     theirs = outcome["figures"]

@@ -8,53 +8,19 @@ other command pays for them.
 
 from __future__ import annotations
 
-import os
 import socket
 import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["StudioPortError", "run_studio", "serve_in_thread", "single_threaded_math",
-           "MATH_THREAD_VARIABLES"]
+from cadgen.math_threads import single_threaded_math
+
+__all__ = ["StudioPortError", "run_studio", "serve_in_thread", "single_threaded_math"]
 
 
 class StudioPortError(OSError):
     """The studio cannot listen on the port asked for (in use, or not allowed)."""
-
-
-#: Environment variables that set the math libraries' thread pools (OpenBLAS, MKL, OpenMP).
-MATH_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-
-
-def single_threaded_math() -> None:
-    """Load numpy and scipy with their BLAS on one thread, in this process only (call first).
-
-    The studio's arrays are small (thousands of samples) and evaluations run one at a
-    time: BLAS threads only spin waiting on each other and on the other processes of
-    the machine (kernel-b's evaluation took 373 ms at the median with the default pool,
-    115 ms with one thread, on a 2-core machine shared with other work). The variables
-    are put back once the libraries have loaded, so the build's separate process gets
-    the machine's defaults.
-    """
-    import sys
-
-    if "numpy" in sys.modules:
-        return   # too late: the pool is made when the library loads
-    saved = {name: os.environ.get(name) for name in MATH_THREAD_VARIABLES}
-    for name in MATH_THREAD_VARIABLES:
-        os.environ.setdefault(name, "1")
-    try:
-        import importlib
-
-        importlib.import_module("numpy")          # loads its OpenBLAS with the variables set
-        importlib.import_module("scipy.linalg")   # scipy's wheels bring their own OpenBLAS
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
 
 
 def _listen(port: int) -> socket.socket:
