@@ -3,6 +3,7 @@ outlines, legends and event names kept off the data, PNG bytes."""
 
 from __future__ import annotations
 
+import functools
 import struct
 import zlib
 
@@ -26,12 +27,55 @@ def _figure(width=7.5, height=5.0, **grid):
     (see :func:`cadgen.report.plots.layout.fit_layout`, run by :func:`_png`). The figure is
     not registered with pyplot: nothing global to create or close.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(width, height), dpi=DPI)
-    FigureCanvasAgg(figure)
+    _canvas_class()(figure)
     return figure, figure.subplots(**grid)
+
+
+@functools.lru_cache(maxsize=1)
+def _canvas_class():
+    """An Agg canvas whose renderer measures texts through one cache for every figure.
+
+    matplotlib caches a text's size per renderer, and each figure has its own: the tick
+    labels, axis labels and legend entries the figures share ("0", "x (mm)") were measured
+    again for each (FreeType lays the string out). The pixels are Agg's.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
+
+    class Renderer(RendererAgg):
+        def get_text_width_height_descent(self, s, prop, ismath):
+            if ismath:
+                return super().get_text_width_height_descent(s, prop, ismath)
+            import matplotlib as mpl
+
+            # what the measure depends on: the string, the font, the resolution, the hinting
+            # (a FontProperties hashes by its current values: a copy is kept as the key)
+            key = (s, prop.copy(), self.dpi, mpl.rcParams["text.hinting"],
+                   mpl.rcParams["text.hinting_factor"])
+            found = _TEXT_SIZES.get(key)
+            if found is None:
+                found = super().get_text_width_height_descent(s, prop, ismath)
+                if len(_TEXT_SIZES) >= 4096:
+                    _TEXT_SIZES.clear()
+                _TEXT_SIZES[key] = found
+            return found
+
+    class Canvas(FigureCanvasAgg):
+        def get_renderer(self):
+            w, h = self.get_width_height(physical=True)
+            key = w, h, self.figure.dpi
+            if getattr(self, "_cadgen_key", None) != key:
+                self.renderer = Renderer(w, h, self.figure.dpi)
+                self._cadgen_key = key
+            return self.renderer
+
+    return Canvas
+
+
+#: ``(string, font, dpi, hinting...) -> (width, height, descent)`` of the texts drawn.
+_TEXT_SIZES: dict = {}
 
 
 def _suptitle(figure, text: str, *, fontsize=12):
@@ -124,9 +168,11 @@ def _png(figure) -> bytes:
     import matplotlib
 
     from cadgen.report.plots.layout import fit_layout
+    from cadgen.report.plots.ticks import batch_ticks
 
     with matplotlib.rc_context(_DRAWING):
         fit_layout(figure, dpi=DPI)
+        batch_ticks(figure)
         figure.canvas.draw()
     rgba = np.asarray(figure.canvas.buffer_rgba())
     return _encode_png(rgba[:, :, :3], dpi=DPI)
@@ -146,8 +192,12 @@ def _encode_png(rgb, *, dpi: float, level: int = PNG_COMPRESSION) -> bytes:
     height, width = rgb.shape[:2]
     rows = np.empty((height, 1 + 3 * width), dtype=np.uint8)
     rows[:, 0] = 0                                              # filter: none
-    # one strided copy straight from the canvas (the RGB of its RGBA), no intermediate
-    rows[:, 1:].reshape(height, width, 3, copy=False)[...] = rgb
+    # straight from the canvas (the RGB of its RGBA), no intermediate, a channel at a time:
+    # numpy copies a plane of single bytes three times faster than (h, w, 3) whole (its
+    # innermost loop would be three bytes long)
+    pixels = rows[:, 1:].reshape(height, width, 3, copy=False)
+    for channel in range(3):
+        pixels[:, :, channel] = rgb[:, :, channel]
 
     def chunk(kind: bytes, data: bytes) -> bytes:
         return (struct.pack(">I", len(data)) + kind + data

@@ -36,7 +36,47 @@ def _silhouette(part, pose):
     # the triangles to merge (the union is the costly part)
     closed = part.mesh.is_watertight and part.mesh.is_winding_consistent
     keep = area > 1e-9 if closed else np.abs(area) > 1e-9
-    return shapely.union_all(shapely.polygons(flat[keep]))
+    if not closed:
+        return shapely.union_all(shapely.polygons(flat[keep]))
+    return _union_by_plane(triangles[keep])
+
+
+def _union_by_plane(triangles):
+    """The union of the xy projections of front-facing ``triangles`` ``(n, 3, 3)`` of a closed,
+    consistently wound mesh.
+
+    The triangles of one plane of the mesh tile a face without overlapping, so each plane's are
+    merged as a coverage (edges dissolved, no overlay: a shaft's end caps in a fifth of the
+    time), and only the planes' faces are overlaid. A plane whose merge does not keep its
+    triangles' area (a T-junction, say) is overlaid triangle by triangle as before.
+    """
+    import shapely
+
+    normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    offset = np.einsum("ij,ij->i", normal, triangles[:, 0])
+    plane = np.round(np.column_stack([normal * 1e6, offset * 1e3])).astype(np.int64)
+    _, group = np.unique(plane, axis=0, return_inverse=True)
+    group = group.ravel()
+    polygons = shapely.polygons(triangles[:, :, :2])
+    if group.max() + 1 > len(triangles) // 2:      # curved: few triangles share a plane
+        return shapely.union_all(polygons)
+    areas = shapely.area(polygons)
+    faces = []
+    for index in range(group.max() + 1):
+        members = polygons[group == index]
+        face = None
+        if len(members) > 1:
+            try:
+                face = shapely.coverage_union_all(members)
+            except shapely.errors.GEOSException:
+                face = None
+            expected = float(areas[group == index].sum())
+            if face is not None and not (face.is_valid and abs(face.area - expected)
+                                         <= 1e-9 * expected):
+                face = None
+        faces.append(face if face is not None else shapely.union_all(members))
+    return shapely.union_all(faces)
 
 
 def assembly_view(assembly, angle: float, *, title: str, paths=(), soil_level=None) -> bytes:
