@@ -179,37 +179,68 @@ def _shaded(mesh, crease_deg: float = CREASE_ANGLE_DEG):
     cosines = np.einsum("fkc,fkc->fk", edges, before) / np.where(norms > 0, norms, 1.0)
     corner_angles = np.arccos(np.clip(cosines, -1.0, 1.0)).ravel()
     corner_vertex = faces.ravel()
-    corner_face = np.repeat(np.arange(len(faces)), 3)
-    # every pair of corners at one vertex: the corners sorted by vertex, then each
-    # corner paired with every corner of its run
-    order = np.argsort(corner_vertex, kind="stable")
-    runs = np.flatnonzero(np.r_[True, corner_vertex[order][1:] != corner_vertex[order][:-1]])
-    counts = np.diff(np.r_[runs, len(order)])
-    run_of = np.repeat(np.arange(len(runs)), counts)
-    repeat = counts[run_of]
-    first = np.repeat(np.arange(len(order)), repeat)
-    offset = np.arange(len(first)) - np.repeat(np.cumsum(repeat) - repeat, repeat)
-    second = runs[run_of[first]] + offset
-    this, other = order[first], order[second]
-    near = np.einsum("ij,ij->i", face_normals[corner_face[this]], face_normals[corner_face[other]]) \
-        >= np.cos(np.radians(crease_deg))
-    # bincount adds in input order, as np.add.at does (same sums, bit for bit), but faster
-    into, weighted = this[near], corner_angles[other[near], None] * face_normals[corner_face[other[near]]]
-    summed = np.column_stack([np.bincount(into, weights=weighted[:, axis], minlength=len(corner_vertex))
-                              for axis in range(3)])
+    corner_normals = np.repeat(face_normals, 3, axis=0)            # each corner's face's
+    keys, key_of = _corner_keys(corner_vertex, corner_normals)
+    summed = _smoothed_sums(corner_vertex, corner_normals, corner_angles, keys,
+                            np.cos(np.radians(crease_deg)))
     size = np.linalg.norm(summed, axis=1)
-    fallback = face_normals[corner_face]
+    fallback = corner_normals[keys]
     fallback[np.linalg.norm(fallback, axis=1) == 0] = (0.0, 0.0, 1.0)
     normals = np.where((size > 1e-12)[:, None], summed / np.where(size > 0, size, 1.0)[:, None], fallback)
     # one vertex per distinct (vertex, normal), sorted by vertex then normal (np.unique's
-    # row order, by a lexsort: np.unique(axis=0) sorts rows as structured bytes, slowly)
-    order = np.lexsort((normals[:, 2], normals[:, 1], normals[:, 0], corner_vertex))
-    keyed_vertex, keyed_normal = corner_vertex[order], normals[order]
+    # row order, by a lexsort: np.unique(axis=0) sorts rows as structured bytes, slowly);
+    # of equal normals the one of the lowest corner is kept (a zero's sign may differ)
+    key_vertex = corner_vertex[keys]
+    order = np.lexsort((keys, normals[:, 2], normals[:, 1], normals[:, 0], key_vertex))
+    keyed_vertex, keyed_normal = key_vertex[order], normals[order]
     starts = np.r_[True, (keyed_vertex[1:] != keyed_vertex[:-1])
                    | np.any(keyed_normal[1:] != keyed_normal[:-1], axis=1)]
     inverse = np.empty(len(order), dtype=np.int64)
     inverse[order] = np.cumsum(starts) - 1
-    return vertices[keyed_vertex[starts]], keyed_normal[starts], inverse.reshape(-1, 3)
+    return vertices[keyed_vertex[starts]], keyed_normal[starts], inverse[key_of].reshape(-1, 3)
+
+
+def _corner_keys(corner_vertex, corner_normals):
+    """Corners grouped by (vertex, face normal's bits): ``(keys, key_of)``, the lowest corner of
+    each group (groups sorted by vertex) and each corner's group. The corners of one group see
+    the same faces within the crease angle, so they get the same smoothed normal: it is
+    summed once per group, not once per corner (half the pairs on these meshes)."""
+    faces_bits = corner_normals[::3].view(np.int64)          # a face's corners share its normal
+    by_bits = np.lexsort(faces_bits.T[::-1])
+    new_bits = np.r_[True, np.any(faces_bits[by_bits][1:] != faces_bits[by_bits][:-1], axis=1)]
+    normal_id = np.empty(len(by_bits), dtype=np.int64)
+    normal_id[by_bits] = np.cumsum(new_bits) - 1
+    key = corner_vertex * int(new_bits.sum()) + np.repeat(normal_id, 3)
+    by_key = np.argsort(key, kind="stable")
+    grouped = key[by_key]
+    new = np.r_[True, grouped[1:] != grouped[:-1]]
+    key_of = np.empty(len(by_key), dtype=np.int64)
+    key_of[by_key] = np.cumsum(new) - 1
+    return by_key[new], key_of
+
+
+def _smoothed_sums(corner_vertex, corner_normals, corner_angles, keys, cos_crease):
+    """(k, 3) per group of :func:`_corner_keys`: the sum of ``angle * normal`` over the corners
+    of its vertex whose face normal is within the crease of the group's (dot >= ``cos_crease``),
+    added in corner order (bincount adds in input order, as np.add.at does: the same sums, bit
+    for bit, as pairing every corner with every corner of its vertex)."""
+    order = np.argsort(corner_vertex, kind="stable")        # each vertex's corners, in order
+    sorted_vertex = corner_vertex[order]
+    runs = np.flatnonzero(np.r_[True, sorted_vertex[1:] != sorted_vertex[:-1]])
+    counts = np.diff(np.r_[runs, len(order)])
+    key_vertex = corner_vertex[keys]
+    key_run = np.cumsum(np.r_[True, key_vertex[1:] != key_vertex[:-1]]) - 1   # keys by vertex
+    repeat = counts[key_run]
+    # pair p: key first[p] with the corner at sorted position other[p] (its vertex's run, in
+    # order); both sides read in sorted order, so the gathers walk memory forwards
+    first = np.repeat(np.arange(len(keys)), repeat)
+    other = np.arange(len(first)) + np.repeat(runs[key_run] - (np.cumsum(repeat) - repeat), repeat)
+    sorted_normals = corner_normals[order]
+    near = np.einsum("ij,ij->i", np.repeat(corner_normals[keys], repeat, axis=0),
+                     sorted_normals[other]) >= cos_crease
+    weighted = (corner_angles[order, None] * sorted_normals)[other[near]]
+    return np.column_stack([np.bincount(first[near], weights=weighted[:, axis], minlength=len(keys))
+                            for axis in range(3)])
 
 
 def _linear(srgb: int) -> list:

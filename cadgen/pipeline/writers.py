@@ -130,7 +130,9 @@ def _write_curves(run, staging):
     for name, (angle, radius) in _pitch_tables(run).items():
         order = np.argsort(np.mod(angle, 2 * np.pi))
         rows = np.column_stack([np.degrees(np.mod(angle, 2 * np.pi))[order], radius[order]])
-        text = "polar_angle_deg,radius_mm\n" + "".join(f"{a:.9f},{r:.9f}\n" for a, r in rows)
+        # python floats (tolist), not numpy's: the same text at a third of the time
+        text = "polar_angle_deg,radius_mm\n" + "".join(f"{a:.9f},{r:.9f}\n"
+                                                        for a, r in rows.tolist())
         path = folder / f"{name.replace(' ', '-')}.csv"
         path.write_text(text, encoding="utf-8")
         written.append(f"curves/{path.name}")

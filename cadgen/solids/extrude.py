@@ -22,6 +22,52 @@ from kinematics.errors import DesignError, Problem
 
 __all__ = ["extrude", "cross_section", "to_trimesh", "part_mesh", "from_trimesh"]
 
+#: Whether :func:`_engine` has started manifold3d's thread pool in this process.
+_ENGINE_STARTED = []
+
+
+def _engine():
+    """manifold3d, its thread pool started with this thread's one core (once per process).
+
+    manifold3d runs its larger steps on oneTBB worker threads, as many as the CPUs the
+    process may use when the pool starts (oneTBB reads the affinity mask then; manifold3d
+    offers no other setting). A build keeps both cores busy already (the sweeps and the
+    figures run beside it in a forked process), and the second thread cost more CPU than it
+    saved: the booleans of xin2024-planter's parts took 0.28 s of CPU on two threads (0.15 s
+    wall), 0.19 s on one. So, in a process asked for one math thread (the command line's
+    choice, :mod:`cadgen.math_threads`: ``OMP_NUM_THREADS=1``), the pool is started on one
+    core, and the mask put back at once for everything else; a library caller's process keeps
+    manifold3d's default. The meshes are the same bits either way (manifold3d's results do
+    not depend on its thread count).
+    """
+    import manifold3d
+
+    if not _ENGINE_STARTED:
+        _ENGINE_STARTED.append(True)
+        _start_on_one_core(manifold3d)
+    return manifold3d
+
+
+def _start_on_one_core(manifold3d) -> None:
+    import os
+
+    if os.environ.get("OMP_NUM_THREADS") != "1":
+        return
+    try:
+        cpus = os.sched_getaffinity(0)
+    except (AttributeError, OSError):      # not Linux: the pool as manifold3d starts it
+        return
+    if len(cpus) < 2:
+        return
+    try:
+        os.sched_setaffinity(0, {min(cpus)})   # this thread only, until put back below
+    except OSError:
+        return
+    try:
+        manifold3d.Manifold.cube((1.0, 1.0, 1.0)).status()   # the pool starts here
+    finally:
+        os.sched_setaffinity(0, cpus)
+
 
 def cross_section(outline, *, holes=(), path: str = "solid", holes_path: str | None = None,
                   area_rtol: float = DEGENERATE_AREA_RTOL,
@@ -57,11 +103,47 @@ def cross_section(outline, *, holes=(), path: str = "solid", holes_path: str | N
     return cross
 
 
+#: Cross sections already validated and built, by content (:func:`_section_key`): a split
+#: housing's slabs share their outlines and holes (the flange slabs above and below the
+#: parting plane have the same section), and each would validate them again.
+_SECTIONS: dict = {}
+#: Sections kept (the oldest forgotten first): a build makes a few dozen distinct ones.
+_SECTIONS_KEPT = 128
+
+
+def _section_key(outline, holes, area_rtol, cross_section_area_rtol):
+    """A key of the cross section's content (the points' bits), or None for input that is not
+    plain numbers (validated, not remembered)."""
+    try:
+        arrays = [np.asarray(outline, dtype=np.float64)] + [np.asarray(h, dtype=np.float64)
+                                                            for h in holes]
+    except (TypeError, ValueError):
+        return None
+    return (float(area_rtol), float(cross_section_area_rtol),
+            tuple((a.shape, np.ascontiguousarray(a).tobytes()) for a in arrays))
+
+
 def _cross_section(outline, holes, path, holes_path, area_rtol, cross_section_area_rtol):
-    import manifold3d
+    """``(cross section, area, problems)``; a valid section is built once per content (the
+    problems name paths and are found again each time)."""
+    holes = list(holes)
+    key = _section_key(outline, holes, area_rtol, cross_section_area_rtol)
+    if key is not None and key in _SECTIONS:
+        cross, expected = _SECTIONS[key]
+        return cross, expected, []
+    cross, expected, problems = _new_cross_section(outline, holes, path, holes_path, area_rtol,
+                                                   cross_section_area_rtol)
+    if key is not None and not problems:
+        if len(_SECTIONS) >= _SECTIONS_KEPT:
+            del _SECTIONS[next(iter(_SECTIONS))]
+        _SECTIONS[key] = (cross, expected)
+    return cross, expected, problems
+
+
+def _new_cross_section(outline, holes, path, holes_path, area_rtol, cross_section_area_rtol):
+    manifold3d = _engine()
 
     outer, problems = outline_problems(outline, path, area_rtol=area_rtol)
-    holes = list(holes)
     if outer is None:
         # The holes cannot be placed against a broken outline, but their own
         # problems are still worth reporting now.
@@ -208,8 +290,23 @@ def _check_volume(mesh, name: str) -> None:
         raise SolidError(name, "watertight", "some edges do not have exactly two faces")
     if not mesh.is_winding_consistent:
         raise SolidError(name, "winding_consistent", "neighbouring faces disagree on orientation")
-    if not mesh.volume > 0:
+    if not _enclosed_volume(mesh.vertices, mesh.faces) > 0:
         raise SolidError(name, "positive_volume", f"the volume is {mesh.volume!r} mm^3 (inside out?)")
+
+
+def _enclosed_volume(vertices, faces) -> float:
+    """mm^3 a closed, consistently wound mesh encloses (negative: inside out).
+
+    The divergence theorem: the sum over the triangles of ``det(a, b, c) / 6``, the
+    vertices taken about their bounding box's centre first (a part far from the origin
+    would otherwise sum large terms that cancel). Only the sign is used here, on every
+    part made: trimesh's ``volume`` integrates all ten mass moments for it, and the
+    report's mass properties (:mod:`cadgen.solids.mass`) are integrated once, there.
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    vertices = vertices - 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    a, b, c = (vertices[np.asarray(faces)[:, k]] for k in range(3))
+    return float(np.einsum("ij,ij->", a, np.cross(b, c))) / 6.0
 
 
 def from_trimesh(mesh, name: str = "mesh"):
@@ -231,7 +328,7 @@ def from_trimesh(mesh, name: str = "mesh"):
     SolidError
         If the mesh is not a proper volume, or manifold3d refuses it (its status).
     """
-    import manifold3d
+    manifold3d = _engine()
 
     _check_volume(mesh, name)
     solid = manifold3d.Manifold(manifold3d.Mesh64(

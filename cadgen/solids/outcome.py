@@ -45,6 +45,7 @@ class SolidsOutcome:
     build_volume: tuple = DEFAULT_BUILD_VOLUME   # mm (x, y, z), the printer's
     process: str = "machined"                    # [manufacturing] process: parts' materials
     _poses: dict = field(default_factory=dict, repr=False)
+    _printed: dict = field(default_factory=dict, repr=False)   # part name -> printing mesh
     _made: dict = field(default_factory=dict, repr=False)   # what once() computed, by key
 
     def once(self, key, compute):
@@ -61,8 +62,11 @@ class SolidsOutcome:
         return self._poses[part.name]
 
     def printing_mesh(self, part):
-        """A copy of the part's mesh in its printing pose (what its STL holds)."""
-        return part.mesh.copy().apply_transform(self.printing_pose(part))
+        """A copy of the part's mesh in its printing pose (what its STL holds), made once per
+        part (the report's print extents and the STL both read it; neither changes it)."""
+        if part.name not in self._printed:
+            self._printed[part.name] = part.mesh.copy().apply_transform(self.printing_pose(part))
+        return self._printed[part.name]
 
 
 def solids_outcome(params, assembly, housings) -> SolidsOutcome:
@@ -96,17 +100,38 @@ def _flat_faces(mesh):
     trimesh's facets (groups of adjacent coplanar triangles) and the triangles in none.
     """
     facets = mesh.facets
+    sizes = np.fromiter((len(f) for f in facets), dtype=np.int64, count=len(facets))
+    member = np.concatenate(facets) if len(facets) else np.zeros(0, dtype=np.int64)
     in_facet = np.zeros(len(mesh.faces), dtype=bool)
-    if len(facets):
-        in_facet[np.concatenate(facets)] = True
+    in_facet[member] = True
     single = np.flatnonzero(~in_facet)
-    areas = np.concatenate([np.asarray(mesh.facets_area, dtype=float).reshape(-1),
-                            mesh.area_faces[single]])
-    normals = np.concatenate([np.asarray(mesh.facets_normal, dtype=float).reshape(-1, 3),
-                              mesh.face_normals[single]])
-    first = np.array([f[0] for f in facets] + single.tolist(), dtype=np.int64)
+    area_faces = np.asarray(mesh.area_faces, dtype=float)
+    face_normals = np.asarray(mesh.face_normals, dtype=float)
+    facet_areas, largest = _facet_areas(sizes, member, area_faces)
+    areas = np.concatenate([facet_areas, area_faces[single]])
+    # a facet's normal is its largest triangle's (trimesh's facets_normal)
+    normals = np.concatenate([face_normals[largest].reshape(-1, 3), face_normals[single]])
+    first = np.concatenate([member[np.cumsum(sizes) - sizes], single]).astype(np.int64)
     points = mesh.vertices[mesh.faces[first, 0]]
     return areas, normals, points
+
+
+def _facet_areas(sizes, member, area_faces):
+    """``(areas, largest)`` of trimesh's facets (``sizes`` triangles each, ``member`` their
+    triangles one facet after another): each facet's area, the sum of its triangles' in facet
+    order from 0 as trimesh's ``facets_area`` adds them (Python's ``sum``; bincount adds in
+    input order too: the same bits), and its largest triangle (the first of equal ones, as
+    ``argmax``), whose normal trimesh's ``facets_normal`` takes. Vectorised: a gear's flanks
+    are thousands of two-triangle facets, a Python call each in trimesh."""
+    if not len(sizes):
+        return np.zeros(0), np.zeros(0, dtype=np.int64)
+    facet_of = np.repeat(np.arange(len(sizes)), sizes)
+    member_areas = area_faces[member]
+    areas = np.bincount(facet_of, weights=member_areas, minlength=len(sizes))
+    biggest = np.maximum.reduceat(member_areas, np.cumsum(sizes) - sizes)
+    at_max = np.flatnonzero(member_areas == biggest[facet_of])
+    _, first_max = np.unique(facet_of[at_max], return_index=True)
+    return areas, member[at_max[first_max]]
 
 
 def _footprint_turn(points) -> np.ndarray:
