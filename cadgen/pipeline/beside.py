@@ -340,20 +340,17 @@ def plots_beside(run, beside):
     for name, draw in jobs.items():
         mine[name] = draw()
         run.progress.step("plots", name)
-    step = lambda name: run.progress.step("plots", name)   # noqa: E731
-    mine.update(_draw_pooled(run, beside, step))
     seconds = time.perf_counter() - start
-    if not beside.done():   # while the worker finishes: what the writing will need
-        from cadgen.pipeline.writers import prepare
+    # first what only this process can make for the writing (the solids' report and files,
+    # the gear files), while the worker draws; then the figures either side may draw, so
+    # that both end together, and the writing after has little left to do
+    from cadgen.pipeline.writers import prepare
 
-        if beside.pool_key.value == -1:   # the worker still sweeps: join its figures after
-            prepare(run, lambda: beside.done() or beside.pool_key.value != -1)
-            begun = time.perf_counter()
-            mine.update(_draw_pooled(run, beside, step))
-            seconds += time.perf_counter() - begun
-        prepare(run, beside.done)
-    begun = time.perf_counter()   # then the pairs' figures the worker has not taken yet
-    mine.update(_draw_taken(pairs, beside.taken, step))
+    prepare(run, lambda: False)
+    step = lambda name: run.progress.step("plots", name)   # noqa: E731
+    begun = time.perf_counter()
+    mine.update(_draw_pooled(run, beside, step))
+    mine.update(_draw_taken(pairs, beside.taken, step))   # the pairs' the worker has not taken
     seconds += time.perf_counter() - begun
     outcome = collect(run, beside)
     theirs = outcome["figures"]

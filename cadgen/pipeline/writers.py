@@ -38,8 +38,8 @@ def writers_for(run) -> list:
 
 def prepare(run, until) -> int:
     """Make what the writing and the report will need, one piece at a time, until ``until()``
-    says stop (the worker beside has finished): the solids' report section, each STL, the
-    assembly file, the gear files. Made once, they are taken as made later (same bytes; the
+    says stop: the solids' report section, each STL, the assembly file, the gear files (the
+    building process makes them while the worker beside draws figures). Made once, they are taken as made later (same bytes; the
     gear files name their folder only in error messages, and a failure is left for the
     writing to raise). Returns the pieces made.
     """
