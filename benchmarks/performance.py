@@ -45,14 +45,25 @@ _CACHE: dict = {}
 
 
 def _cadgen(*args, cwd=None) -> float:
-    """Wall time (s) of one ``cadgen`` command in a fresh interpreter."""
+    """Wall time (s) of one ``cadgen`` command in a fresh interpreter (its CPU time, user and
+    system, its forked worker included, is appended to ``_CPU``)."""
+    import resource
+
     environment = dict(os.environ)
     if "directory" in _CACHE:
         environment["CADGEN_CACHE_DIR"] = str(_CACHE["directory"])
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run([sys.executable, "-m", "cadgen", *args], check=False, cwd=cwd,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=environment)
-    return time.perf_counter() - start
+    seconds = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    _CPU.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return seconds
+
+
+#: CPU seconds of each :func:`_cadgen` command, in order.
+_CPU: list = []
 
 
 def _empty_cache() -> None:
@@ -68,11 +79,16 @@ PEER_ARGS = ("-m", "ncgears", "--centrode", "30 + 8*cos(phi)", "--teeth", "24",
 def _peer(python: Path) -> float:
     """Wall time (s) of the peer's command line in a fresh interpreter (in a scratch folder:
     it writes its files to the working directory)."""
+    import resource
+
     with tempfile.TemporaryDirectory() as scratch:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         done = subprocess.run([str(python), *PEER_ARGS], cwd=scratch, stdout=subprocess.DEVNULL,
                               stderr=subprocess.PIPE, text=True)
         seconds = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    _CPU.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
     if done.returncode != 0:
         raise RuntimeError(f"ncgears failed (exit {done.returncode}): {done.stderr.strip()}")
     return seconds
@@ -87,20 +103,25 @@ def interleaved_rounds(root: Path, rounds: int, peer_python: Path | None) -> dic
     """``{scene: [wall seconds per round]}`` for the peer and the three builds, run in turn in
     each round, and ``"stages"``: the stage times of the last cold and warm builds."""
     times = {"peer": [], "cold": [], "warm": [], "metrics": []}
+    cpu = {"peer": [], "cold": [], "warm": [], "metrics": []}
     stages = {}
     args = ["build", str(PARAMS), "--output-dir"]
     for index in range(rounds):
         if peer_python is not None:
             times["peer"].append(_peer(peer_python))
+            cpu["peer"].append(_CPU[-1])
         _empty_cache()
         times["cold"].append(_cadgen(*args, str(root / "cold")))
+        cpu["cold"].append(_CPU[-1])
         stages["cold"] = _stages(root / "cold")
         times["warm"].append(_cadgen(*args, str(root / "warm")))
+        cpu["warm"].append(_CPU[-1])
         stages["warm"] = _stages(root / "warm")
         times["metrics"].append(_cadgen(*args, str(root / "metrics"), "--effects", "metrics"))
+        cpu["metrics"].append(_CPU[-1])
         print(f"round {index + 1}/{rounds}: " + ", ".join(
             f"{scene} {runs[-1]:.2f} s" for scene, runs in times.items() if runs), flush=True)
-    times["stages"] = stages
+    times["stages"], times["cpu"] = stages, cpu
     return times
 
 
@@ -187,7 +208,7 @@ def main(argv=None):
         times = interleaved_rounds(root, 1 if args.quick else args.rounds, peer_python)
         sweeps = [] if args.quick else sweep_table()
         batch = [] if args.quick else batch_table(root)
-    stages = times.pop("stages")
+    stages, cpu = times.pop("stages"), times.pop("cpu")
     medians = {scene: statistics.median(runs) for scene, runs in times.items() if runs}
     peer = medians.get("peer")
     cores = os.cpu_count()
@@ -201,9 +222,10 @@ def main(argv=None):
              "generating and verifying ONE 24-tooth pair from its command line "
              "(`python -m ncgears --centrode \"30 + 8*cos(phi)\" --teeth 24 --module 2.5`); "
              "our build cuts, checks and meshes five pairs and does everything else. "
-             "Issue 15's aims: cold full build <= 0.35 x the peer, metrics only <= 0.05 x.", "",
-             "| command | median (s) | spread (s) | x peer (medians) | aim |",
-             "|---|---:|---:|---:|---:|"]
+             "Issue 15's aims: cold full build <= 0.35 x the peer, metrics only <= 0.05 x. "
+             "CPU: user and system time of the command and the worker it forks, median.", "",
+             "| command | median (s) | spread (s) | x peer (medians) | aim | CPU (s) |",
+             "|---|---:|---:|---:|---:|---:|"]
     labels = {"peer": ("ncgears 0.3.1, one pair (the peer)", ""),
               "cold": ("`cadgen build`, every effect, gear cache cold", "0.35"),
               "warm": ("`cadgen build`, every effect, gear cache warm", ""),
@@ -213,7 +235,9 @@ def main(argv=None):
             continue
         ratio = f"{medians[scene] / peer:.3f}" if peer else "n/a"
         label, aim = labels[scene]
-        lines.append(f"| {label} | {medians[scene]:.2f} | {_spread(runs)} | {ratio} | {aim} |")
+        used = f"{statistics.median(cpu[scene]):.2f}" if cpu.get(scene) else ""
+        lines.append(f"| {label} | {medians[scene]:.2f} | {_spread(runs)} | {ratio} | {aim} "
+                     f"| {used} |")
     lines += ["", "Stages of the last cold and warm full builds (seconds; the rest of the wall "
               "time is interpreter start, imports and writing the files):", "",
               "| stage | cold (s) | warm (s) |", "|---|---:|---:|"]

@@ -10,8 +10,9 @@ each pose's contact (:class:`WindowEdges`), without a pass over every vertex and
   own radial span;
 * angular bins first: the turns that decide a mesh are small, so a point is first tried
   only against the edges within one angular bin of it; a pose settles there when its turns
-  both ways are shorter than a bin (the pairs not tried turn further), else its points are
-  tried against every edge of its window.
+  both ways are shorter than a bin (the pairs not tried turn further). Fine bins first
+  (:data:`FINE_ANGLE_BINS`), then coarse ones (:data:`ANGLE_BINS`) for the poses left, and
+  the points of any pose still unsettled are tried against every edge of its window.
 
 numpy only.
 """
@@ -20,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["WindowEdges", "first_contact_turns", "ANGLE_BINS"]
+__all__ = ["WindowEdges", "first_contact_turns", "ANGLE_BINS", "FINE_ANGLE_BINS"]
 
 
 class WindowEdges:
@@ -54,6 +55,11 @@ class WindowEdges:
 #: decide a mesh are tenths of a degree); a pose with nothing that close either way is
 #: searched again over every edge of its window.
 ANGLE_BINS = 180
+#: Angular bins of the first try (0.25 deg each): a mesh's first contacts are about a tenth of
+#: a degree away (measured: at most 0.13 deg on the paper's pairs, kernel-b's 0.12), so the
+#: poses settle there among an eighth of the pairs of :data:`ANGLE_BINS`' 2 deg bins; the
+#: poses that do not are tried again with those.
+FINE_ANGLE_BINS = 1440
 #: rad: an edge's polar extent is widened by this before binning (the crossing's polar angle
 #: is computed, not exact), and a turn must be this much inside one bin to be taken.
 _ANGLE_SLACK = 1e-9
@@ -133,16 +139,22 @@ def first_contact_turns(points: WindowEdges, edges: WindowEdges, poses: int):
     radial = np.floor(high / width).astype(np.int64) - low_bin + 1
     point_bin = np.floor(radii / width).astype(np.int64)
     spans = (low, high, bins, low_bin, radial, point_bin)
-    found = _nearest_turns(points, edges, poses, spans)
-    if found is not None:
-        positive, negative, settled = found
+    settled = np.zeros(poses, dtype=bool)
+    points_in, edges_in = None, None     # None: every point and edge
+    for count in (FINE_ANGLE_BINS, ANGLE_BINS):
+        found = _nearest_turns(points, edges, poses, spans, count, points_in, edges_in)
+        if found is None:
+            continue
+        # a pose's extremes among the pairs tried are its true ones once it settles
+        found_positive, found_negative, done = found
+        done &= ~settled
+        positive[done], negative[done] = found_positive[done], found_negative[done]
+        settled |= done
         if settled.all():
             return positive, negative
-        # the rest: every edge of the pose's window at the point's radius
-        points_in = ~settled[points.pose]
-        edges_in = ~settled[edges.pose]
-    else:
-        settled = np.zeros(poses, dtype=bool)
+        points_in, edges_in = ~settled[points.pose], ~settled[edges.pose]
+    # the rest: every edge of the pose's window at the point's radius
+    if points_in is None:
         points_in = np.ones(len(points), dtype=bool)
         edges_in = np.ones(len(edges), dtype=bool)
     edge, offset = _spread(low_bin[edges_in], radial[edges_in])
@@ -168,9 +180,11 @@ def _extremes(angle, pose, poses: int):
     return positive, negative
 
 
-def _nearest_turns(points: WindowEdges, edges: WindowEdges, poses: int, spans):
-    """The first pass of :func:`first_contact_turns`: only the pairs whose polar angles are
-    within one angular bin (``2 pi / ANGLE_BINS``) of each other.
+def _nearest_turns(points: WindowEdges, edges: WindowEdges, poses: int, spans,
+                   angle_bins: int = ANGLE_BINS, points_in=None, edges_in=None):
+    """A first pass of :func:`first_contact_turns`: only the pairs whose polar angles are
+    within one angular bin (``2 pi / angle_bins``) of each other, among the points and edges
+    of ``points_in`` and ``edges_in`` (masks; None: all).
 
     A pair turning by at most one bin width has the crossing's polar angle in the point's
     bin or a neighbour, and the edge is listed in every bin its polar extent (so the
@@ -181,41 +195,44 @@ def _nearest_turns(points: WindowEdges, edges: WindowEdges, poses: int, spans):
     cannot help (an edge spanning a third of the turn).
     """
     low, high, bins, low_bin, radial, point_bin = spans
-    radii = points.radius
-    step = 2 * np.pi / ANGLE_BINS
-    a0 = edges.polar
-    sweep = edges.polar_end - a0
+    step = 2 * np.pi / angle_bins
+    chosen = np.arange(len(edges)) if edges_in is None else np.flatnonzero(edges_in)
+    a0 = edges.polar[chosen]
+    sweep = edges.polar_end[chosen] - a0
     sweep = (sweep + np.pi) % (2 * np.pi) - np.pi     # the shorter way round
     # bins counted from -pi without wrapping; an edge across +-pi lists bins past the end,
     # taken modulo the count below
     first_angle = np.floor((a0 + np.minimum(sweep, 0.0) - _ANGLE_SLACK + np.pi) / step)
     last_angle = np.floor((a0 + np.maximum(sweep, 0.0) + _ANGLE_SLACK + np.pi) / step)
     angular = (last_angle - first_angle + 1).astype(np.int64)
-    if angular.max() >= ANGLE_BINS // 3:
+    if angular.size == 0 or angular.max() >= angle_bins // 3:
         return None
-    cells = radial * angular
+    cells = radial[chosen] * angular
     if (cells == 1).all():     # short edges, the usual case: one cell each
         edge, offset = np.arange(len(cells)), np.zeros(len(cells), dtype=np.int64)
     else:
         edge, offset = _spread(np.zeros(len(cells), dtype=np.int64), cells)
-    radius_bin = low_bin[edge] + offset // angular[edge]
-    angle_bin = (first_angle[edge].astype(np.int64) + offset % angular[edge]) % ANGLE_BINS
-    key = (edges.pose[edge] * bins + radius_bin) * ANGLE_BINS + angle_bin
-    own = np.floor((points.polar + np.pi) / step).astype(np.int64) % ANGLE_BINS
-    base = (points.pose * bins + point_bin) * ANGLE_BINS
+    radius_bin = low_bin[chosen][edge] + offset // angular[edge]
+    angle_bin = (first_angle[edge].astype(np.int64) + offset % angular[edge]) % angle_bins
+    edge = chosen[edge]
+    key = (edges.pose[edge] * bins + radius_bin) * angle_bins + angle_bin
+    which = np.arange(len(points)) if points_in is None else np.flatnonzero(points_in)
+    own = np.floor((points.polar[which] + np.pi) / step).astype(np.int64) % angle_bins
+    base = (points.pose[which] * bins + point_bin[which]) * angle_bins
     listing = _Listing(key, edge)
     # the point's angular bin and its two neighbours: one run of keys, but for a point in the
     # first or the last bin, whose neighbour across -pi is looked up on its own
     i, j = listing.pairs(base + np.maximum(own - 1, 0), base + np.minimum(own + 1,
-                                                                           ANGLE_BINS - 1))
+                                                                           angle_bins - 1))
     edge_wise = [(i, j)]
-    for end, other in ((0, ANGLE_BINS - 1), (ANGLE_BINS - 1, 0)):
+    for end, other in ((0, angle_bins - 1), (angle_bins - 1, 0)):
         at = np.flatnonzero(own == end)
         if at.size:
             k, j_end = listing.pairs(base[at] + other)
             edge_wise.append((at[k], j_end))
-    i = np.concatenate([pair[0] for pair in edge_wise])
+    i = which[np.concatenate([pair[0] for pair in edge_wise])]
     j = np.concatenate([pair[1] for pair in edge_wise])
+    radii = points.radius
     keep = (low[j] <= radii[i]) & (high[j] >= radii[i])
     i, j = i[keep], j[keep]
     positive, negative = _extremes(_crossing_turns(points, i, edges, j), points.pose[i], poses)
