@@ -490,12 +490,12 @@ def _write(run, final: Path) -> BuildResult:
                 progress.step(WRITE_STAGE, _group([f"plots/{n}" for n in run.figures]))
             files.append("report.json")
             if "report" in run.effects:
-                from cadgen.report.animation import animation_data
+                from cadgen.pipeline.writers import animation_of
                 from cadgen.report.html import render_html
 
                 glb = staging / "solids" / "assembly.glb"   # the 3D view shows the file written
                 (staging / "report.html").write_text(render_html(
-                    report, run.figures, animation=animation_data(run.params, run.values),
+                    report, run.figures, animation=animation_of(run),
                     assembly_glb=glb.read_bytes() if glb.is_file() else None), encoding="utf-8")
                 files.append("report.html")
                 progress.step(WRITE_STAGE, "report.html")

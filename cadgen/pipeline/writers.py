@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["writers_for", "prepare"]
+__all__ = ["writers_for", "prepare", "animation_of"]
 
 
 def writers_for(run) -> list:
@@ -38,8 +38,8 @@ def writers_for(run) -> list:
 
 def prepare(run, until) -> int:
     """Make what the writing and the report will need, one piece at a time, until ``until()``
-    says stop: the solids' report section, each STL, the assembly file, the gear files (the
-    building process makes them while the worker beside draws figures). Made once, they are taken as made later (same bytes; the
+    says stop: the solids' report section, each STL, the assembly file, the gear files, the
+    report's animation (the building process makes them while the worker beside draws). Made once, they are taken as made later (same bytes; the
     gear files name their folder only in error messages, and a failure is left for the
     writing to raise). Returns the pieces made.
     """
@@ -65,7 +65,20 @@ def prepare(run, until) -> int:
             made += 1
         except Exception:   # said again, with the staging folder's paths, when written
             run.__dict__.pop("_gear_files", None)
+    if "report" in run.effects and not until():
+        animation_of(run)
+        made += 1
     return made
+
+
+def animation_of(run) -> dict:
+    """The report's animation data (:func:`cadgen.report.animation.animation_data`), made once
+    per run: :func:`prepare` may have made it."""
+    if "_animation" not in run.__dict__:
+        from cadgen.report.animation import animation_data
+
+        run.__dict__["_animation"] = animation_data(run.params, run.values)
+    return run.__dict__["_animation"]
 
 
 def _write_bom(run, staging):
