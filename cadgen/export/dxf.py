@@ -59,6 +59,7 @@ __all__ = [
     "CONSTRUCTION_LAYERS",
     "write_gear_dxf",
     "write_cam_dxf",
+    "cam_dxf_bytes",
     "gear_dxf_bytes",
     "writer_fingerprint",
 ]
@@ -578,17 +579,32 @@ def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius:
     on ``BORE``; ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and
     a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as :func:`write_gear_dxf`.
     """
+    path = Path(path)
+    data, outline, used = _cam_file(path, contour, pitch_curve, bore_radius, chord_tolerance,
+                                    label)
+    write_bytes_atomic(path, data)
+    area, perimeter = ring_measures(outline)
+    return DxfSummary(path, len(outline), used, area, perimeter)
+
+
+def cam_dxf_bytes(contour, pitch_curve, *, bore_radius: float = 0.0,
+                  chord_tolerance: float = 0.005, label: str = "cam",
+                  path: str | os.PathLike = "cam.dxf") -> bytes:
+    """The bytes :func:`write_cam_dxf` writes (``path`` names the file in error messages
+    only), for a build that makes them before its output folder exists."""
+    return _cam_file(Path(path), contour, pitch_curve, bore_radius, chord_tolerance, label)[0]
+
+
+def _cam_file(path: Path, contour, pitch_curve, bore_radius, chord_tolerance, label):
+    """``(bytes, thinned outline, tolerance used)`` of a cam's DXF file."""
     tolerance = _check_tolerance(chord_tolerance)
     centre = np.zeros(2)
     problems = _plate_problems(contour, pitch_curve, centre, bore_radius, label)
     if problems:
         raise DxfInputError(f"cannot export {label} to DXF", problems)
-    path = Path(path)
     outline, used = thin_outline(closed_points(contour), tolerance, centre, bore_radius)
     pitch, _ = thin_ring(closed_points(pitch_curve), tolerance)
     doc = _new_document()
     _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
               CAM_CENTRE_MARK_HALF_LENGTH / CENTRE_MARK_HALF_LENGTH_MODULES)
-    write_bytes_atomic(path, _audited_bytes(doc, path))
-    area, perimeter = ring_measures(outline)
-    return DxfSummary(path, len(outline), used, area, perimeter)
+    return _audited_bytes(doc, path), outline, used

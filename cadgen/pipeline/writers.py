@@ -39,7 +39,7 @@ def writers_for(run) -> list:
 def prepare(run, until) -> int:
     """Make what the writing and the report will need, one piece at a time, until ``until()``
     says stop: the solids' report section, each STL, the assembly file, the gear files, the
-    report's animation (the building process makes them while the worker beside draws). Made once, they are taken as made later (same bytes; the
+    cam's file, the report's animation (the building process makes them while the worker beside draws). Made once, they are taken as made later (same bytes; the
     gear files name their folder only in error messages, and a failure is left for the
     writing to raise). Returns the pieces made.
     """
@@ -65,6 +65,13 @@ def prepare(run, until) -> int:
             made += 1
         except Exception:   # said again, with the staging folder's paths, when written
             run.__dict__.pop("_gear_files", None)
+    if "dxf" in run.effects and run.status("cam") == "ok" and run.values["cam"].cuttable \
+            and not until():
+        try:
+            _cam_file(run, Path("cam.dxf"))
+            made += 1
+        except Exception:   # said again, with the staging folder's path, when written
+            run.__dict__.pop("_cam_file", None)
     if "report" in run.effects and not until():
         animation_of(run)
         made += 1
@@ -114,21 +121,33 @@ def _gear_files(run, folder: Path):
 
 
 def _write_cam(run, staging):
-    from cadgen.export.dxf import write_cam_dxf
+    from cadgen.export.atomic import write_bytes_atomic
 
-    from cadgen.solids.planting import cam_bore_radius
-
-    params, design = run.params, run.values["cam"]
-    points = params.cam.profile_points
-    shafts = run.values.get("drivetrain")
-    if shafts is None:   # a scene with the cam alone: size the shafts here (milliseconds)
-        from cadgen.machine.drivetrain import drivetrain
-
-        shafts = drivetrain(params, run.values["kinematics"])
-    write_cam_dxf(staging / "cam.dxf", design.profile.working_profile(points),
-                  design.profile.pitch_curve(points), bore_radius=cam_bore_radius(params, shafts),
-                  chord_tolerance=params.gears.chord_tolerance)
+    write_bytes_atomic(staging / "cam.dxf", _cam_file(run, staging / "cam.dxf"))
     return ["cam.dxf"]
+
+
+def _cam_file(run, path: Path) -> bytes:
+    """The cam's DXF bytes (``path`` names it in error messages), made once per run:
+    :func:`prepare` may have made them (and so loaded ezdxf while the worker beside draws)."""
+    made = run.__dict__.setdefault("_cam_file", {})
+    if "bytes" not in made:
+        from cadgen.export.dxf import cam_dxf_bytes
+
+        from cadgen.solids.planting import cam_bore_radius
+
+        params, design = run.params, run.values["cam"]
+        points = params.cam.profile_points
+        shafts = run.values.get("drivetrain")
+        if shafts is None:   # a scene with the cam alone: size the shafts here (milliseconds)
+            from cadgen.machine.drivetrain import drivetrain
+
+            shafts = drivetrain(params, run.values["kinematics"])
+        made["bytes"] = cam_dxf_bytes(
+            design.profile.working_profile(points), design.profile.pitch_curve(points),
+            bore_radius=cam_bore_radius(params, shafts),
+            chord_tolerance=params.gears.chord_tolerance, path=path)
+    return made["bytes"]
 
 
 #: Samples per turn of each tabulated pitch curve.
