@@ -9,8 +9,10 @@ paper's design 3.72 -> 3.48 s of CPU, a metrics-only build 0.225 -> 0.212 s; the
 kernel-b evaluation 373 -> 115 ms at the median on a shared machine.
 
 manifold3d's oneTBB pool has no such variable; it takes the CPUs the process may use when it
-starts, so :mod:`cadgen.solids.extrude` starts it on one core where ``OMP_NUM_THREADS`` is 1
-(the booleans of the paper design's parts: 0.28 s of CPU on two threads, 0.19 s on one).
+starts, so :func:`cadgen.solids.extrude.manifold3d_engine` starts it on one core in every
+process (a build forks, and a oneTBB worker holding a lock at the fork would leave it held in
+the child; and the booleans of the paper design's parts take 0.28 s of CPU on two threads,
+0.19 s on one).
 
 The pool is sized when the library loads, so this is set before anything imports numpy:
 by the command line for every command (:func:`one_thread_for_commands`; its child

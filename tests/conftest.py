@@ -62,6 +62,18 @@ def _session_gear_cache(tmp_path_factory):
         yield
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _manifold3d_without_worker_threads():
+    """manifold3d's pool started as cadgen starts it (one core, no worker thread), before any
+    test runs a boolean of its own: the suite's process forks builds' workers, and a oneTBB
+    worker holding a lock at a fork leaves the child waiting on it
+    (see ``cadgen.solids.extrude.manifold3d_engine``)."""
+    from cadgen.solids.extrude import manifold3d_engine
+
+    manifold3d_engine()
+    yield
+
+
 def load_script(name: str):
     """``scripts/<name>.py`` as a module (the screenshot scripts hold the page checks)."""
     spec = importlib.util.spec_from_file_location(name, REPO / "scripts" / f"{name}.py")

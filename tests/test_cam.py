@@ -284,7 +284,7 @@ def test_unknown_cam_law_is_refused_at_load():
 def test_cam_dxf_is_one_closed_cutting_path_within_the_chord_tolerance(paper, tmp_path):
     import ezdxf
 
-    from cadgen.export.dxf import write_cam_dxf
+    from cadgen.export.cam_dxf import write_cam_dxf
 
     profile = paper[3].profile
     contour, pitch = profile.working_profile(3600), profile.pitch_curve(3600)

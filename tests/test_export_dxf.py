@@ -15,8 +15,9 @@ shapely = pytest.importorskip("shapely")
 
 import cadgen.export.atomic
 import cadgen.export.dxf as export_dxf
+from cadgen.export.cam_dxf import write_cam_dxf
 from cadgen.export.dxf import (CENTRE_LAYER, CUTTING_LAYERS, LABEL_LAYER, PITCH_CURVE_GAP, PITCH_LAYER,
-                               DxfExportError, DxfInputError, DxfSummary, write_cam_dxf, write_gear_dxf)
+                               DxfExportError, DxfInputError, DxfSummary, write_gear_dxf)
 from cadgen.export.train_sheet import write_train_sheet
 from cadgen.gears.teeth import GearProfile
 from kinematics.errors import MechanismError

@@ -1,4 +1,5 @@
-"""DXF export of generated gears (one cutting file per gear, an assembled train sheet) and cams.
+"""DXF export of generated gears (one cutting file per gear, an assembled train sheet) and cams
+(the cam's file: :mod:`cadgen.export.cam_dxf`, on this module's layers and document).
 
 Layers, in millimetres. Only the two *cutting* layers hold cutting paths, and they are plotted;
 everything else is construction geometry on ``CONSTRUCTION-...`` layers whose plot flag is off
@@ -58,8 +59,6 @@ __all__ = [
     "CUTTING_LAYERS",
     "CONSTRUCTION_LAYERS",
     "write_gear_dxf",
-    "write_cam_dxf",
-    "cam_dxf_bytes",
     "gear_dxf_bytes",
     "writer_fingerprint",
 ]
@@ -79,8 +78,6 @@ _CENTRE_LINETYPE_PATTERN = [20.0, 12.0, -3.0, 2.0, -3.0]
 DXF_VERSION = "R2010"
 #: Half length of each centre-mark line, in modules (the whole mark is two modules wide).
 CENTRE_MARK_HALF_LENGTH_MODULES = 1.0
-#: Half length of each centre-mark line of a cam drawing (mm).
-CAM_CENTRE_MARK_HALF_LENGTH = 5.0
 #: mm: the pitch curve's closing stretch left out, well above any CAM program's joining tolerance.
 PITCH_CURVE_GAP = 1.0
 #: Train sheet: label height (mm), gap (modules) under a gear whose label does not fit inside
@@ -569,42 +566,3 @@ def _raise_gear_problems(profile) -> None:
     problems = _gear_problems(profile)
     if problems:
         raise DxfInputError(f"cannot export gear {getattr(profile, 'name', '?')!r} to DXF", problems)
-
-
-def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius: float = 0.0,
-                  chord_tolerance: float = 0.005, label: str = "cam") -> DxfSummary:
-    """Write a plate cam as a DXF cutting file (mm), laid out like a gear file.
-
-    ``contour`` (the working profile) on ``OUTLINE`` (the one closed cutting path), the bore
-    on ``BORE``; ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and
-    a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as :func:`write_gear_dxf`.
-    """
-    path = Path(path)
-    data, outline, used = _cam_file(path, contour, pitch_curve, bore_radius, chord_tolerance,
-                                    label)
-    write_bytes_atomic(path, data)
-    area, perimeter = ring_measures(outline)
-    return DxfSummary(path, len(outline), used, area, perimeter)
-
-
-def cam_dxf_bytes(contour, pitch_curve, *, bore_radius: float = 0.0,
-                  chord_tolerance: float = 0.005, label: str = "cam",
-                  path: str | os.PathLike = "cam.dxf") -> bytes:
-    """The bytes :func:`write_cam_dxf` writes (``path`` names the file in error messages
-    only), for a build that makes them before its output folder exists."""
-    return _cam_file(Path(path), contour, pitch_curve, bore_radius, chord_tolerance, label)[0]
-
-
-def _cam_file(path: Path, contour, pitch_curve, bore_radius, chord_tolerance, label):
-    """``(bytes, thinned outline, tolerance used)`` of a cam's DXF file."""
-    tolerance = _check_tolerance(chord_tolerance)
-    centre = np.zeros(2)
-    problems = _plate_problems(contour, pitch_curve, centre, bore_radius, label)
-    if problems:
-        raise DxfInputError(f"cannot export {label} to DXF", problems)
-    outline, used = thin_outline(closed_points(contour), tolerance, centre, bore_radius)
-    pitch, _ = thin_ring(closed_points(pitch_curve), tolerance)
-    doc = _new_document()
-    _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
-              CAM_CENTRE_MARK_HALF_LENGTH / CENTRE_MARK_HALF_LENGTH_MODULES)
-    return _audited_bytes(doc, path), outline, used

@@ -132,7 +132,7 @@ def _cam_file(run, path: Path) -> bytes:
     :func:`prepare` may have made them (and so loaded ezdxf while the worker beside draws)."""
     made = run.__dict__.setdefault("_cam_file", {})
     if "bytes" not in made:
-        from cadgen.export.dxf import cam_dxf_bytes
+        from cadgen.export.cam_dxf import cam_dxf_bytes
 
         from cadgen.solids.planting import cam_bore_radius
 

@@ -20,25 +20,33 @@ from cadgen.solids.outline import holes_problems, outline_problems, signed_area
 from cadgen.solids.tolerances import CROSS_SECTION_AREA_RTOL, DEGENERATE_AREA_RTOL
 from kinematics.errors import DesignError, Problem
 
-__all__ = ["extrude", "cross_section", "to_trimesh", "part_mesh", "from_trimesh"]
+__all__ = ["extrude", "cross_section", "to_trimesh", "part_mesh", "from_trimesh",
+           "manifold3d_engine"]
 
-#: Whether :func:`_engine` has started manifold3d's thread pool in this process.
+#: Whether :func:`manifold3d_engine` has started manifold3d's thread pool in this process.
 _ENGINE_STARTED = []
 
 
-def _engine():
-    """manifold3d, its thread pool started with this thread's one core (once per process).
+def manifold3d_engine():
+    """manifold3d, its thread pool started with this thread's one core (once per process):
+    every use of manifold3d in cadgen goes through here.
 
     manifold3d runs its larger steps on oneTBB worker threads, as many as the CPUs the
     process may use when the pool starts (oneTBB reads the affinity mask then; manifold3d
-    offers no other setting). A build keeps both cores busy already (the sweeps and the
-    figures run beside it in a forked process), and the second thread cost more CPU than it
-    saved: the booleans of xin2024-planter's parts took 0.28 s of CPU on two threads (0.15 s
-    wall), 0.19 s on one. So, in a process asked for one math thread (the command line's
-    choice, :mod:`cadgen.math_threads`: ``OMP_NUM_THREADS=1``), the pool is started on one
-    core, and the mask put back at once for everything else; a library caller's process keeps
-    manifold3d's default. The meshes are the same bits either way (manifold3d's results do
-    not depend on its thread count).
+    offers no other setting). Two reasons for one thread:
+
+    - **Fork safety.** A build forks a worker beside the teeth (:mod:`cadgen.pipeline.beside`).
+      A oneTBB worker thread that holds one of the library's locks at the instant of the fork
+      leaves the lock held, forever, in the child, whose next boolean then waits on it (seen
+      once in the test suite: a forked worker stuck in ``tbb::detail::r1::wait_on_address``
+      under ``Manifold.status``). With no worker threads there is no such lock to inherit.
+    - **CPU.** The build keeps both cores busy already (the worker beside runs the sweeps
+      and draws), and the second thread cost more CPU than it saved: the booleans of
+      xin2024-planter's parts took 0.28 s of CPU on two threads (0.15 s wall), 0.19 s on one.
+
+    The mask is put back at once for everything else. The meshes are the same bits either way
+    (manifold3d's results do not depend on its thread count). A caller that ran manifold3d's
+    booleans in this process before cadgen did keeps the pool it started.
     """
     import manifold3d
 
@@ -51,8 +59,6 @@ def _engine():
 def _start_on_one_core(manifold3d) -> None:
     import os
 
-    if os.environ.get("OMP_NUM_THREADS") != "1":
-        return
     try:
         cpus = os.sched_getaffinity(0)
     except (AttributeError, OSError):      # not Linux: the pool as manifold3d starts it
@@ -141,7 +147,7 @@ def _cross_section(outline, holes, path, holes_path, area_rtol, cross_section_ar
 
 
 def _new_cross_section(outline, holes, path, holes_path, area_rtol, cross_section_area_rtol):
-    manifold3d = _engine()
+    manifold3d = manifold3d_engine()
 
     outer, problems = outline_problems(outline, path, area_rtol=area_rtol)
     if outer is None:
@@ -228,7 +234,7 @@ def extrude(outline, height: float, *, holes=(), z0: float = 0.0, path: str = "s
 
 
 def _check_status(solid, name: str) -> None:
-    import manifold3d
+    manifold3d = manifold3d_engine()
 
     status = solid.status()
     if status != manifold3d.Error.NoError:
@@ -328,7 +334,7 @@ def from_trimesh(mesh, name: str = "mesh"):
     SolidError
         If the mesh is not a proper volume, or manifold3d refuses it (its status).
     """
-    manifold3d = _engine()
+    manifold3d = manifold3d_engine()
 
     _check_volume(mesh, name)
     solid = manifold3d.Manifold(manifold3d.Mesh64(

@@ -294,7 +294,9 @@ def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
 
 def _planter_parts(params, cam_design, layout, segments):
     """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades."""
-    import manifold3d as m3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
 
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import hull_of_circles

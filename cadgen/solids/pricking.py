@@ -188,7 +188,9 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
 
 def _rocker_and_needle(params, link, needle, *, z0, segments):
     """The rocker bar from B along +x (l1) and the needle from its end, perpendicular, to D."""
-    import manifold3d as m3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
 
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import hull_of_circles

@@ -450,7 +450,9 @@ def segment_problems(housing, cuts, build_volume, *, margin: float = SEGMENT_MAR
 
 def _prism(corners, z_low, z_high):
     """A vertical prism on a convex quadrilateral's (4, 2) corners, manifold3d."""
-    import manifold3d as m3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
 
     corners = np.asarray(corners, dtype=float)
     (ax, ay), (bx, by) = corners[1] - corners[0], corners[2] - corners[0]
@@ -472,7 +474,9 @@ def _slab(point_low, point_high, normal, reach, z_low, z_high):
 
 def _bolt_hole(centre, axis, length, diameter, segments):
     """A cylinder (a ``segments``-gon) of ``diameter`` along ``axis``, centred on ``centre``."""
-    import manifold3d as m3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
 
     hole = m3d.Manifold.cylinder(length, diameter / 2, diameter / 2, segments, True)
     angle = math.degrees(math.atan2(axis[1], axis[0]))
@@ -506,7 +510,9 @@ def segment_housing(housing, cuts, *, segments: int, name: str = "housing") -> S
     SolidInputError
         For cuts that are not parallel lines crossing the housing, or bad ``segments``.
     """
-    import manifold3d as m3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
 
     if isinstance(segments, bool) or int(segments) != segments or segments < 3:
         raise SolidInputError("segments", f"segments must be an integer >= 3, not {segments!r}")

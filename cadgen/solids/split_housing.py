@@ -360,7 +360,9 @@ def split_housing(circles, *, clearance: float, wall: float, floor_wall: float, 
     SolidInputError
         For ``segments`` < 3 or a bolt size that is not ``M<d>``.
     """
-    import manifold3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    manifold3d = manifold3d_engine()
 
     circles = np.asarray(circles, dtype=float)
     if circles.ndim == 1 and circles.size == 3:
@@ -525,7 +527,9 @@ def shaft_solid(diameter: float, z_bottom: float, z_top: float, *, keyseats=(),
     SolidInputError
         For a bad dimension (the value in the message).
     """
-    import manifold3d
+    from cadgen.solids.extrude import manifold3d_engine
+
+    manifold3d = manifold3d_engine()
     import shapely
 
     diameter, z_bottom, z_top = float(diameter), float(z_bottom), float(z_top)

@@ -1,0 +1,61 @@
+"""The duckbill cam's DXF cutting file: the plate laid out like a gear's file
+(:mod:`cadgen.export.dxf`: its layers, document, thinning and audit), with its roller's pitch
+curve as construction.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from cadgen.export.atomic import write_bytes_atomic
+from cadgen.export.dxf import (CENTRE_MARK_HALF_LENGTH_MODULES, DxfInputError, DxfSummary,
+                               _add_gear, _audited_bytes, _check_tolerance, _new_document,
+                               _plate_problems)
+from cadgen.geometry.contour import closed_points, ring_measures, thin_outline, thin_ring
+
+__all__ = ["write_cam_dxf", "cam_dxf_bytes", "CAM_CENTRE_MARK_HALF_LENGTH"]
+
+#: Half length of each centre-mark line of a cam drawing (mm).
+CAM_CENTRE_MARK_HALF_LENGTH = 5.0
+
+
+def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius: float = 0.0,
+                  chord_tolerance: float = 0.005, label: str = "cam") -> DxfSummary:
+    """Write a plate cam as a DXF cutting file (mm), laid out like a gear file.
+
+    ``contour`` (the working profile) on ``OUTLINE`` (the one closed cutting path), the bore
+    on ``BORE``; ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and
+    a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as :func:`write_gear_dxf`.
+    """
+    path = Path(path)
+    data, outline, used = _cam_file(path, contour, pitch_curve, bore_radius, chord_tolerance,
+                                    label)
+    write_bytes_atomic(path, data)
+    area, perimeter = ring_measures(outline)
+    return DxfSummary(path, len(outline), used, area, perimeter)
+
+
+def cam_dxf_bytes(contour, pitch_curve, *, bore_radius: float = 0.0,
+                  chord_tolerance: float = 0.005, label: str = "cam",
+                  path: str | os.PathLike = "cam.dxf") -> bytes:
+    """The bytes :func:`write_cam_dxf` writes (``path`` names the file in error messages
+    only), for a build that makes them before its output folder exists."""
+    return _cam_file(Path(path), contour, pitch_curve, bore_radius, chord_tolerance, label)[0]
+
+
+def _cam_file(path: Path, contour, pitch_curve, bore_radius, chord_tolerance, label):
+    """``(bytes, thinned outline, tolerance used)`` of a cam's DXF file."""
+    tolerance = _check_tolerance(chord_tolerance)
+    centre = np.zeros(2)
+    problems = _plate_problems(contour, pitch_curve, centre, bore_radius, label)
+    if problems:
+        raise DxfInputError(f"cannot export {label} to DXF", problems)
+    outline, used = thin_outline(closed_points(contour), tolerance, centre, bore_radius)
+    pitch, _ = thin_ring(closed_points(pitch_curve), tolerance)
+    doc = _new_document()
+    _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
+              CAM_CENTRE_MARK_HALF_LENGTH / CENTRE_MARK_HALF_LENGTH_MODULES)
+    return _audited_bytes(doc, path), outline, used
