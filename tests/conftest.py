@@ -7,8 +7,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cadgen.solids.extrude import manifold3d_engine
 from kinematics.pitch_curves import LimaconPitchCurve
 from kinematics.planting import PlantingMechanism
+
+# manifold3d's pool started as cadgen starts it (one core, no worker thread) before any test
+# module is collected: some build solids at import, and the suite's process forks builds'
+# workers; a oneTBB worker holding a lock at a fork leaves the child waiting on it for ever
+# (see cadgen.solids.extrude.manifold3d_engine)
+manifold3d_engine()
 
 REPO = Path(__file__).resolve().parents[1]
 PAPER_LIMACON = dict(a1=1.2, b1=27.5, c1=-5.5, d1=30.5, e1=2.66, e2=1.0,
@@ -60,18 +67,6 @@ def _session_gear_cache(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("CADGEN_CACHE_DIR", str(tmp_path_factory.mktemp("gear-cache")))
         yield
-
-
-@pytest.fixture(scope="session", autouse=True)
-def _manifold3d_without_worker_threads():
-    """manifold3d's pool started as cadgen starts it (one core, no worker thread), before any
-    test runs a boolean of its own: the suite's process forks builds' workers, and a oneTBB
-    worker holding a lock at a fork leaves the child waiting on it
-    (see ``cadgen.solids.extrude.manifold3d_engine``)."""
-    from cadgen.solids.extrude import manifold3d_engine
-
-    manifold3d_engine()
-    yield
 
 
 def load_script(name: str):
