@@ -16,11 +16,13 @@ import pytest
 from cadgen.math_threads import MATH_THREAD_VARIABLES
 
 
-def _run(code: str, **environment) -> dict:
+def _run(code: str, *args, **environment) -> dict:
+    """What ``code`` prints (JSON), run in a fresh interpreter with ``args``, without the
+    math thread variables of this process but those given."""
     env = {k: v for k, v in os.environ.items() if k not in MATH_THREAD_VARIABLES}
     env.update(environment)
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
-                          timeout=120)
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          env=env, timeout=120)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -82,12 +84,7 @@ print(json.dumps({"base": base, "threads": threads(), "before": before,
 
 
 def _engine(way: str) -> dict:
-    env = {k: v for k, v in os.environ.items() if k not in MATH_THREAD_VARIABLES}
-    env["OPENBLAS_NUM_THREADS"] = "1"     # numpy's pool out of the count
-    done = subprocess.run([sys.executable, "-c", ENGINE, way], capture_output=True, text=True,
-                          env=env, timeout=120)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
+    return _run(ENGINE, way, OPENBLAS_NUM_THREADS="1")   # numpy's pool out of the count
 
 
 @pytest.mark.skipif(not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2

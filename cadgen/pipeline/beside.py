@@ -42,7 +42,7 @@ class _Beside:
     """The forked worker's tasks (its solids and sweeps, its figures, then the gear pairs'
     figures from data sent after the teeth) and the sweep stages it runs."""
 
-    pool: object
+    executor: object        # the one worker's (its tasks run in order)
     solids: object          # future: {"stages": ..., "meshes": {name: (vertices, faces)}}
     figures: object         # future: {"figures": ..., "seconds": ...}
     sweeps: tuple
@@ -55,8 +55,8 @@ class _Beside:
         """Send the last task (the pairs' figures to draw, or none): it closes the worker's
         progress pipe, and the worker ends after it."""
         if self.pairs is None:
-            self.pairs = self.pool.submit(_beside_pairs, pairs or {})
-            self.pool.shutdown(wait=False)
+            self.pairs = self.executor.submit(_beside_pairs, pairs or {})
+            self.executor.shutdown(wait=False)
         return self.pairs
 
     def done(self) -> bool:
@@ -183,9 +183,8 @@ def _beside_figures() -> dict:
             progress.started("plots", detail="figures", beside=True)
             pooled = pooled_figures(jobs)
             _BESIDE["pool_key"].value = _list_key(pooled)
-            while (index := _take(_BESIDE["pool"], len(pooled))) is not None:
-                figures[pooled[index]] = jobs[pooled[index]]()
-                progress.step("plots", pooled[index], steps=0, beside=True)
+            figures = _draw_from(_BESIDE["pool"], pooled, lambda name: jobs[name](),
+                                 lambda name: progress.step("plots", name, steps=0, beside=True))
             for name in jobs.keys() - set(pooled):
                 figures[name] = jobs[name]()
                 progress.step("plots", name, steps=0, beside=True)
@@ -200,7 +199,7 @@ def _beside_figures() -> dict:
 #: Drawing time of the gearless figures that take longest (CPU seconds, paper design): they
 #: go first in the pool, so the short ones even out the two processes' ends.
 _SLOW_FIGURES = {"cam-follower.png": 0.11, "housing-gearbox1.png": 0.11,
-                 "housing-gearbox2.png": 0.10, "housing.png": 0.10}
+                 "housing-gearbox2.png": 0.10}
 
 
 def pooled_figures(jobs) -> list:
@@ -228,11 +227,7 @@ def _draw_pooled(run, beside, drawn) -> dict:
     pooled = pooled_figures(jobs)
     if not pooled or beside.pool_key.value != _list_key(pooled):
         return {}
-    figures = {}
-    while (index := _take(beside.figure_pool, len(pooled))) is not None:
-        figures[pooled[index]] = jobs[pooled[index]]()
-        drawn(pooled[index])
-    return figures
+    return _draw_from(beside.figure_pool, pooled, lambda name: jobs[name](), drawn)
 
 
 def _beside_pairs(pairs: dict) -> dict:
@@ -274,13 +269,19 @@ def take_meshes(run, beside) -> int:
 
 
 def _draw_taken(pairs: dict, counter, drawn) -> dict:
-    """Draw the gear pairs' figures that neither process has taken yet, taking them one at a
-    time from ``counter`` (shared by both); ``drawn(name)`` after each. Returns the PNGs."""
+    """The gear pairs' figures neither process has taken yet (:func:`_draw_from`)."""
     from cadgen.report.plots.parts import draw_pair_figure
 
-    names, figures = list(pairs), {}
+    return _draw_from(counter, list(pairs), lambda name: draw_pair_figure(pairs[name]), drawn)
+
+
+def _draw_from(counter, names: list, draw, drawn) -> dict:
+    """Draw the figures of ``names`` that neither process has taken yet, taking them one at a
+    time from ``counter`` (shared by both): ``draw(name)`` makes one's PNG, ``drawn(name)`` is
+    called after each. Returns ``{name: PNG bytes}`` of those drawn here."""
+    figures = {}
     while (index := _take(counter, len(names))) is not None:
-        figures[names[index]] = draw_pair_figure(pairs[names[index]])
+        figures[names[index]] = draw(names[index])
         drawn(names[index])
     return figures
 
@@ -346,7 +347,7 @@ def plots_beside(run, beside):
     # that both end together, and the writing after has little left to do
     from cadgen.pipeline.writers import prepare
 
-    prepare(run, lambda: False)
+    prepare(run)
     step = lambda name: run.progress.step("plots", name)   # noqa: E731
     begun = time.perf_counter()
     mine.update(_draw_pooled(run, beside, step))

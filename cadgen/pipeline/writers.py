@@ -36,12 +36,12 @@ def writers_for(run) -> list:
     return writers
 
 
-def prepare(run, until) -> int:
-    """Make what the writing and the report will need, one piece at a time, until ``until()``
-    says stop: the solids' report section, each STL, the assembly file, the gear files, the
-    cam's file, the report's animation (the building process makes them while the worker beside draws). Made once, they are taken as made later (same bytes; the
-    gear files name their folder only in error messages, and a failure is left for the
-    writing to raise). Returns the pieces made.
+def prepare(run) -> int:
+    """Make what the writing and the report will need: the solids' report section, each STL,
+    the assembly file, the gear files, the cam's file, the report's animation (the building
+    process makes them while the worker beside draws). Made once, they are taken as made
+    later (same bytes; the files name their folder only in error messages, and a failure is
+    left for the writing to raise). Returns the pieces made.
     """
     if run.status("parts") != "ok":
         return 0
@@ -50,29 +50,24 @@ def prepare(run, until) -> int:
 
     outcome = run.values["parts"]
     made = 0
-    if until():
-        return made
     solids_report(outcome)
     made += 1
     if "stl" in run.effects:
         for _ in solids_files(outcome):
             made += 1
-            if until():
-                return made
     if "dxf" in run.effects and run.status("teeth") == "ok" and run.values["teeth"].stages:
         try:
             _gear_files(run, Path("gears"))
             made += 1
         except Exception:   # said again, with the staging folder's paths, when written
             run.__dict__.pop("_gear_files", None)
-    if "dxf" in run.effects and run.status("cam") == "ok" and run.values["cam"].cuttable \
-            and not until():
+    if "dxf" in run.effects and run.status("cam") == "ok" and run.values["cam"].cuttable:
         try:
             _cam_file(run, Path("cam.dxf"))
             made += 1
         except Exception:   # said again, with the staging folder's path, when written
             run.__dict__.pop("_cam_file", None)
-    if "report" in run.effects and not until():
+    if "report" in run.effects:
         animation_of(run)
         made += 1
     return made
