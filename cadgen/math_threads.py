@@ -47,8 +47,7 @@ def single_threaded_math() -> None:
     if "numpy" in sys.modules:
         return   # too late: the pool is made when the library loads
     saved = {name: os.environ.get(name) for name in MATH_THREAD_VARIABLES}
-    for name in MATH_THREAD_VARIABLES:
-        os.environ.setdefault(name, "1")
+    one_thread_for_commands()
     try:
         import importlib
 
