@@ -53,3 +53,49 @@ def test_a_build_with_the_worker_beside_equals_one_in_one_process(path, tmp_path
     files = _files(forked.output_dir)
     assert any(name.startswith("plots/") for name in files)
     assert files == _files(alone.output_dir)
+
+
+def test_the_building_process_takes_the_workers_meshes_of_the_gearless_parts(tmp_path,
+                                                                              monkeypatch):
+    """The worker meshes the gearless parts for its sweeps and sends them back first: the
+    building process (this one) must not mesh them again for the assembly view and the
+    solids' files (a quarter of a second of the paper design's CPU, made twice before), even
+    when the worker's sweeps are far from done (made slow here: the worker is forked from
+    this process, so it runs the patched stage)."""
+    import importlib
+    import time
+
+    import cadgen.pipeline.beside as beside
+    import cadgen.pipeline.build
+
+    extrude = importlib.import_module("cadgen.solids.extrude")  # the package's name is a function
+    meshed_here, assemblies = [], []
+    to_trimesh, take_meshes = extrude.to_trimesh, beside.take_meshes
+
+    def counting(solid, name):
+        meshed_here.append(name)     # in this process only: the worker's calls are its own
+        return to_trimesh(solid, name)
+
+    def taking(run, worker):
+        assemblies.append(run.values["parts"].assembly)
+        return take_meshes(run, worker)
+
+    def slow(run, sweep=cadgen.pipeline.build.STAGE_FUNCTIONS["arm_interference"]):
+        time.sleep(2.0)
+        return sweep(run)
+
+    monkeypatch.setattr(extrude, "to_trimesh", counting)
+    monkeypatch.setattr(beside, "take_meshes", taking)
+    monkeypatch.setitem(cadgen.pipeline.build.STAGE_FUNCTIONS, "arm_interference", slow)
+    params = load_params(ROOT / "params" / "xin2024-planter.toml")
+    result = build(params, tmp_path)       # every effect: the STLs need every mesh too
+    assert any("second process" in r["message"] for r in result.report["stages"])
+    kinds = beside.gearless_kinds(params.mechanism)
+    parts = {p.name: p.kind for p in assemblies[0].parts}
+    gearless = {name for name, kind in parts.items() if kind in kinds}
+    assert gearless and len(gearless) < len(parts)     # both kinds are in the paper design
+    assert not gearless & set(meshed_here)
+    assert set(parts) - gearless <= set(meshed_here)   # the gears' parts are meshed here
+    # every part has its mesh, and each its STL
+    assert all(p._mesh is not None for p in assemblies[0].parts)
+    assert {f.stem for f in (result.output_dir / "solids").glob("*.stl")} >= set(parts)

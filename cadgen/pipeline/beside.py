@@ -3,11 +3,13 @@ show no gear, while the building process cuts the gears.
 
 On a machine with a second core and the fork start method, :func:`start_beside` forks one
 worker when the teeth stage begins. The worker inherits every value computed so far (nothing
-is pickled on the way in), builds the gearless parts, runs the FCL sweeps on them (only where
-the housings do not depend on the gears: the assembly module's ``GEARLESS_KINDS``), then
-draws figures that show no gear; its results come back pickled (sweep records and values,
-PNG bytes). The building process cuts the teeth, builds the parts with the gears, draws the
-assembly view (:func:`plots_beside`), then shares the rest: the worker's gearless figures and
+is pickled on the way in), builds and meshes the gearless parts (only where the housings do
+not depend on the gears: the assembly module's ``GEARLESS_KINDS``) and sends their meshes
+back at once, runs the FCL sweeps on them, then draws figures that show no gear; its results
+come back pickled (meshes, sweep records and values, PNG bytes). The building process cuts
+the teeth, builds the parts with the gears, takes the worker's meshes (drawing gear pairs'
+figures while they are not there yet) for the assembly view and the solids' files
+(:func:`plots_beside`), then shares the rest: the worker's gearless figures and
 the gear pairs' are taken one at a time from counters both processes hold, whoever is free
 first, so neither waits on the other's last figures; then it collects the worker's results
 (:func:`collect`). What is computed is the same either way, file for file
@@ -39,11 +41,12 @@ def gearless_kinds(mechanism: str) -> frozenset:
 
 @dataclass
 class _Beside:
-    """The forked worker's tasks (its solids and sweeps, its figures, then the gear pairs'
-    figures from data sent after the teeth) and the sweep stages it runs."""
+    """The forked worker's tasks (its gearless parts' meshes, its sweeps, its figures, then
+    the gear pairs' figures from data sent after the teeth) and the sweep stages it runs."""
 
     executor: object        # the one worker's (its tasks run in order)
-    solids: object          # future: {"stages": ..., "meshes": {name: (vertices, faces)}}
+    meshes: object          # future: {part name: (vertices, faces)} of the gearless parts
+    solids: object          # future: {"stages": {stage: (record, value)}} of the sweeps
     figures: object         # future: {"figures": ..., "seconds": ...}
     sweeps: tuple
     taken: object           # shared counter: the next gear pair's figure to draw, either side
@@ -103,38 +106,59 @@ def start_beside(run, functions):
                    events=ends[1] if ends else None, taken=taken, pool=pool, pool_key=pool_key)
     executor = ProcessPoolExecutor(1, mp_context=context)
     try:
-        solids = executor.submit(_beside_solids)   # forks the worker here
-        figures = executor.submit(_beside_figures)  # the same worker, after the first task
+        meshes = executor.submit(_beside_parts)     # forks the worker here
+        solids = executor.submit(_beside_sweeps)    # the same worker, tasks in order
+        figures = executor.submit(_beside_figures)
     finally:
         _BESIDE.clear()             # the forked worker has its own copy
         if ends:
             run.progress.relay(ends[0])
             ends[1].close()         # the worker's copy is the last: its end is the relay's
-    return _Beside(executor, solids, figures, sweeps, taken, pool, pool_key)
+    return _Beside(executor, meshes, solids, figures, sweeps, taken, pool, pool_key)
 
 
-def _beside_solids() -> dict:
-    """In the forked worker, first: the gearless parts and each sweep.
-
-    ``{"stages": {stage: (record, value)}, "meshes": {part name: (vertices, faces)}}``: the
-    meshes of the parts of :func:`gearless_kinds` that the sweeps made.
+def _beside_parts() -> dict:
+    """In the forked worker, first: the gearless parts, every one meshed (the sweeps need
+    most; the building process all, for the assembly view and the solids' files), sent back
+    before the sweeps. ``{part name: (vertices, faces)}``, empty if the parts failed (their
+    record is then the worker's, and the sweeps are skipped).
     """
-    run, functions, sweeps = _BESIDE["run"], _BESIDE["functions"], _BESIDE["sweeps"]
-    events, progress = _BESIDE.get("events"), run.progress
+    run, events, progress = _BESIDE["run"], _BESIDE.get("events"), _BESIDE["run"].progress
     if events is not None:
         progress.forward(events)
+    if not _BESIDE["sweeps"]:
+        return {}
+    try:
+        progress.started("parts", detail="without gears, for the sweeps", beside=True)
+        start = time.perf_counter()
+        record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
+        meshes = {}
+        if record.status == "ok":
+            kinds = gearless_kinds(run.params.mechanism)
+            # meshed within the stage's time: the sweeps would mesh most of them anyway
+            meshes = {part.name: (part.mesh.vertices, part.mesh.faces)
+                      for part in parts.assembly.parts if part.kind in kinds}
+            record.seconds = time.perf_counter() - start
+            run.values["parts"] = parts
+            run.records.append(record)
+        _BESIDE["parts_record"] = record
+        progress.finished("parts", record.status, record.seconds,
+                          detail=record.message or "without gears, for the sweeps", beside=True)
+        return meshes
+    except BaseException:
+        _BESIDE["failed"] = True    # the next tasks compute nothing
+        raise
+
+
+def _beside_sweeps() -> dict:
+    """In the forked worker, second: each sweep on the gearless parts.
+    ``{"stages": {stage: (record, value)}}``."""
+    run, functions, sweeps = _BESIDE["run"], _BESIDE["functions"], _BESIDE["sweeps"]
+    progress, parts_record = run.progress, _BESIDE.get("parts_record")
+    if _BESIDE.get("failed"):
+        return {"stages": {}}       # the parts' exception is the one collected
     try:
         out = {}
-        parts_record = None
-        if sweeps:
-            progress.started("parts", detail="without gears, for the sweeps", beside=True)
-            parts_record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
-            progress.finished("parts", parts_record.status, parts_record.seconds,
-                              detail=parts_record.message or "without gears, for the sweeps",
-                              beside=True)
-            if parts_record.status == "ok":
-                run.values["parts"] = parts
-                run.records.append(parts_record)
         for stage in sweeps:
             if parts_record.status != "ok":
                 record = StageRecord(stage, "skipped",
@@ -151,15 +175,9 @@ def _beside_solids() -> dict:
             run.records.append(record)
             if record.status == "ok":
                 run.values[stage] = value
-        meshes = {}
-        if parts_record is not None and parts_record.status == "ok":
-            kinds = gearless_kinds(run.params.mechanism)
-            meshes = {part.name: (part._mesh.vertices, part._mesh.faces)
-                      for part in run.values["parts"].assembly.parts
-                      if part.kind in kinds and part._mesh is not None}
-        return {"stages": out, "meshes": meshes}
+        return {"stages": out}
     except BaseException:
-        _BESIDE["failed"] = True    # the next tasks draw nothing
+        _BESIDE["failed"] = True
         raise
 
 
@@ -253,13 +271,16 @@ def _beside_pairs(pairs: dict) -> dict:
 
 def take_meshes(run, beside) -> int:
     """Give this build's parts the worker's meshes of the same parts (:func:`gearless_kinds`)
-    where it made them and this process has not yet: the same triangles, not made twice.
-    Returns how many were taken (none before the worker's first task is done)."""
-    if not beside.solids.done() or run.status("parts") != "ok":
+    where this process has not made them: the same triangles, not made twice. Waits for the
+    worker's first task (it meshes them first of all). Returns how many were taken."""
+    if run.status("parts") != "ok":
+        return 0
+    meshes = beside.meshes.result()
+    if not meshes:
         return 0
     from cadgen.solids.extrude import part_mesh
 
-    meshes, kinds = beside.solids.result()["meshes"], gearless_kinds(run.params.mechanism)
+    kinds = gearless_kinds(run.params.mechanism)
     taken = 0
     for part in run.values["parts"].assembly.parts:
         if part.kind in kinds and part._mesh is None and part.name in meshes:
@@ -268,19 +289,22 @@ def take_meshes(run, beside) -> int:
     return taken
 
 
-def _draw_taken(pairs: dict, counter, drawn) -> dict:
+def _draw_taken(pairs: dict, counter, drawn, until=None) -> dict:
     """The gear pairs' figures neither process has taken yet (:func:`_draw_from`)."""
     from cadgen.report.plots.parts import draw_pair_figure
 
-    return _draw_from(counter, list(pairs), lambda name: draw_pair_figure(pairs[name]), drawn)
+    return _draw_from(counter, list(pairs), lambda name: draw_pair_figure(pairs[name]), drawn,
+                      until)
 
 
-def _draw_from(counter, names: list, draw, drawn) -> dict:
+def _draw_from(counter, names: list, draw, drawn, until=None) -> dict:
     """Draw the figures of ``names`` that neither process has taken yet, taking them one at a
     time from ``counter`` (shared by both): ``draw(name)`` makes one's PNG, ``drawn(name)`` is
-    called after each. Returns ``{name: PNG bytes}`` of those drawn here."""
+    called after each; none more once ``until()`` is true. Returns ``{name: PNG bytes}`` of
+    those drawn here."""
     figures = {}
-    while (index := _take(counter, len(names))) is not None:
+    while not (until is not None and until()) \
+            and (index := _take(counter, len(names))) is not None:
         figures[names[index]] = draw(names[index])
         drawn(names[index])
     return figures
@@ -300,11 +324,11 @@ def collect(run, beside) -> dict:
     """The worker's results: its sweep stages recorded here (as if run here), its figures."""
     beside.finish()
     last = beside.pairs.result()
+    take_meshes(run, beside)    # first: the worker's first task's exception, if it raised
     outcome = {**beside.solids.result(), **beside.figures.result()}
     outcome["figures"] = {**outcome["figures"], **last["figures"]}
     outcome["seconds"] += last["seconds"]
     run.progress.join()         # the worker's events, all delivered
-    take_meshes(run, beside)
     for stage in beside.sweeps:
         failed = [need for need in STAGE_NEEDS[stage] if run.status(need) != "ok"]
         if failed:
@@ -336,11 +360,15 @@ def plots_beside(run, beside):
     jobs = {name: draw for name, draw in figure_jobs(run).items()
             if _shows_gears(name) and name not in pairs}
     run.progress.started("plots")
-    take_meshes(run, beside)    # the assembly view meshes every part: the worker's, if made
-    mine = {}
+    step = lambda name: run.progress.step("plots", name)   # noqa: E731
+    # the assembly view and the solids' files need every part's mesh: the gearless ones are
+    # the worker's first task (it meshes them for its sweeps); the gear pairs' figures until
+    # they are here
+    mine = _draw_taken(pairs, beside.taken, step, until=beside.meshes.done)
+    take_meshes(run, beside)
     for name, draw in jobs.items():
         mine[name] = draw()
-        run.progress.step("plots", name)
+        step(name)
     seconds = time.perf_counter() - start
     # first what only this process can make for the writing (the solids' report and files,
     # the gear files), while the worker draws; then the figures either side may draw, so
@@ -348,7 +376,6 @@ def plots_beside(run, beside):
     from cadgen.pipeline.writers import prepare
 
     prepare(run)
-    step = lambda name: run.progress.step("plots", name)   # noqa: E731
     begun = time.perf_counter()
     mine.update(_draw_pooled(run, beside, step))
     mine.update(_draw_taken(pairs, beside.taken, step))   # the pairs' the worker has not taken
