@@ -181,6 +181,42 @@ def test_a_key_changes_with_what_determines_the_stage():
     assert len({key, *others}) == len(others) + 1
 
 
+_KEY_IN_A_FRESH_PROCESS = """
+import sys
+from cadgen.gears.cache import stage_key
+from cadgen.gears.pairs import circle_pair
+from cadgen.gears.teeth import ToothSystem
+assert "scipy" not in sys.modules   # what the key once read as scipy=None
+print(stage_key("s", circle_pair(("a", "b"), 20.0, 30.0), (20, 30), ToothSystem(2.0),
+                flank_points=48, bore_radius=5.0, force_shaper=False, poses=32, span=None,
+                circular=True))
+"""
+
+
+def test_a_key_does_not_depend_on_what_the_process_has_imported():
+    """The libraries' versions are part of a key: read whether or not the process has
+    imported them yet (a key made before the cutting first loaded scipy once differed from
+    the same gear's key in a process that had: a second process missed the first's
+    entries)."""
+    import subprocess
+    import sys
+
+    import scipy
+
+    from cadgen.gears.pairs import circle_pair
+    from cadgen.gears.teeth import ToothSystem
+
+    fresh = subprocess.run([sys.executable, "-c", _KEY_IN_A_FRESH_PROCESS], capture_output=True,
+                           text=True, check=True, cwd=REPO).stdout.strip()
+    here = stage_key("s", circle_pair(("a", "b"), 20.0, 30.0), (20, 30), ToothSystem(2.0),
+                     flank_points=48, bore_radius=5.0, force_shaper=False, poses=32, span=None,
+                     circular=True)
+    assert fresh == here
+    from cadgen.gears.cache import _libraries
+
+    assert f"scipy={scipy.__version__}" in _libraries()     # the versions are in the key
+
+
 @pytest.mark.parametrize("damage", ["truncated", "flipped"])
 def test_a_bad_entry_is_a_miss_and_the_build_recomputes_it(paper, uncached, tmp_path, damage):
     cache = tmp_path / "cache"

@@ -243,12 +243,20 @@ def code_fingerprint() -> str:
 
 
 def _libraries() -> str:
-    """Versions of the numerical libraries a stage's numbers depend on (already imported)."""
+    """Versions of the numerical libraries a stage's numbers depend on.
+
+    Imported here, not looked up among the modules already loaded: a key made before the
+    cutting first imported scipy read ``scipy=None`` (and shapely's, GEOS's), so the same
+    gear had two keys depending on what the process had loaded (a second process cutting
+    the same train missed the first's entries), and the key did not hold those versions.
+    """
+    import importlib
+
     names = []
     for name in ("numpy", "scipy", "shapely"):
-        module = sys.modules.get(name)
+        module = importlib.import_module(name)
         names.append(f"{name}={getattr(module, '__version__', None)}")
-    shapely = sys.modules.get("shapely")
+    shapely = sys.modules["shapely"]
     names.append(f"geos={getattr(shapely, 'geos_version_string', None)}")
     names.append(f"python={sys.version_info[:2]} machine={platform.machine()}")
     return " ".join(names)
