@@ -17,7 +17,9 @@ Run:  python -m benchmarks.performance [--output docs/performance.md] [--quick]
 2. **Certified sweep against a plain 3600-pose scan**, both clearances of the
    paper's assembly with the build's own scenes and bounds (blades included), each
    against a reference (the certified sweep at ``atol`` 1e-10 mm): time, ratio, error.
-3. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
+3. **Accuracy presets**: the full build (gear cache cold) at ``--preset`` draft, standard
+   (the default) and fine, three runs each: what the README's preset table quotes.
+4. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
    design (every effect), on 1 and on 2 worker processes: designs per minute and
    the speed-up.
 
@@ -161,6 +163,21 @@ def sweep_table() -> list:
     return rows
 
 
+def preset_table(root: Path, runs: int = 3) -> list:
+    """``[(preset, median wall s, spread, median CPU s)]``: the full build, cache cold."""
+    rows = []
+    for preset in ("draft", "standard", "fine"):
+        walls, cpus = [], []
+        for _ in range(runs):
+            _empty_cache()
+            walls.append(_cadgen("build", str(PARAMS), "--preset", preset, "--output-dir",
+                                 str(root / f"preset-{preset}")))
+            cpus.append(_CPU[-1])
+        rows.append((preset, statistics.median(walls), _spread(walls), statistics.median(cpus)))
+        print(f"preset {preset}: {rows[-1][1]:.2f} s", flush=True)
+    return rows
+
+
 GRID = """base = "{base}"
 name = "perf"
 [grid]
@@ -207,6 +224,7 @@ def main(argv=None):
         _CACHE["directory"] = root / "gear-cache"
         times = interleaved_rounds(root, 1 if args.quick else args.rounds, peer_python)
         sweeps = [] if args.quick else sweep_table()
+        presets = [] if args.quick else preset_table(root)
         batch = [] if args.quick else batch_table(root)
     stages, cpu = times.pop("stages"), times.pop("cpu")
     medians = {scene: statistics.median(runs) for scene, runs in times.items() if runs}
@@ -254,6 +272,14 @@ def main(argv=None):
         base = sweeps[index - index % 2][5]
         lines.append(f"| {label} | {method} | {value:.9f} | {error:.1e} | {poses} | "
                      f"{seconds:.2f} | {seconds / base:.1f} |")
+    if presets:
+        lines += ["", "## Accuracy presets", "",
+                  "The full build of the paper's design, every effect, gear cache cold, at "
+                  "each `--preset` (three runs each, median; the knobs each sets are in the "
+                  "README and cadgen/params/scene.py).", "",
+                  "| preset | median (s) | spread (s) | CPU (s) |", "|---|---:|---:|---:|"]
+        lines += [f"| {preset} | {wall:.2f} | {spread} | {used:.2f} |"
+                  for preset, wall, spread, used in presets]
     if batch:
         lines += ["", "## Batch throughput", "",
                   "`cadgen batch` over a grid of 4 variants of the paper's design (L2 = 186 to "
