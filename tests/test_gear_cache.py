@@ -87,6 +87,36 @@ def test_a_warm_build_writes_the_gear_files_without_making_them(paper, uncached,
     assert files == uncached
 
 
+_WARM_CAM_BUILD = """
+import sys
+import cadgen
+params = cadgen.load_params(sys.argv[1])
+result = cadgen.build(params, sys.argv[2], effects=["teeth", "cam", "dxf"], cache=sys.argv[3])
+assert (result.report["gear_cache"]["hits"], result.report["gear_cache"]["misses"]) == (5, 0)
+print("ezdxf" in sys.modules)
+"""
+
+
+def test_a_warm_build_writes_the_cam_file_without_loading_ezdxf(paper, tmp_path):
+    """The cam's DXF bytes are kept beside the gear files: a warm build (a fresh interpreter)
+    writes every cutting file and never imports ezdxf, and the cam file it writes is the
+    uncached build's byte for byte."""
+    import subprocess
+    import sys
+
+    effects, cache = ["teeth", "cam", "dxf"], tmp_path / "cache"
+    alone = cadgen.build(paper, tmp_path / "uncached", effects=effects, cache=False)
+    cold = cadgen.build(paper, tmp_path / "cold", effects=effects, cache=cache)
+    loaded = subprocess.run([sys.executable, "-c", _WARM_CAM_BUILD, str(PAPER),
+                             str(tmp_path / "warm"), str(cache)], capture_output=True,
+                            text=True, check=True, cwd=REPO).stdout.strip()
+    assert loaded == "False"
+    cam = [(folder / paper.name / "cam.dxf").read_bytes()
+           for folder in (tmp_path / "uncached", tmp_path / "cold", tmp_path / "warm")]
+    assert cam[0] == cam[1] == cam[2] and cam[0].startswith(b"  0\nSECTION")
+    assert alone.report["gear_cache"]["used"] is False and cold.report["gear_cache"]["misses"] == 5
+
+
 def test_a_damaged_file_entry_is_made_again(paper, uncached, tmp_path):
     cache = tmp_path / "cache"
     _build(paper, tmp_path / "cold", cache)

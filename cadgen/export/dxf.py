@@ -478,6 +478,7 @@ _WRITER: list = []
 def writer_fingerprint() -> str:
     """SHA-256 of what decides a written gear file's bytes besides its inputs: the sources of
     the writers and of the thinning (this module, :mod:`cadgen.export.train_sheet`,
+    :mod:`cadgen.export.cam_dxf`,
     :mod:`cadgen.geometry.contour`, :mod:`cadgen.machine.hubs`) and ezdxf's version. Part of
     the gear cache's key of a file (:func:`cadgen.gears.cache.file_key`): an edit is a new key."""
     if not _WRITER:
@@ -490,7 +491,7 @@ def writer_fingerprint() -> str:
         # the installed version, read without importing ezdxf: a warm build need not load it
         digest = hashlib.sha256(f"ezdxf={version('ezdxf')}\0".encode())
         here = Path(__file__).parent
-        for source in (Path(__file__), here / "train_sheet.py",
+        for source in (Path(__file__), here / "train_sheet.py", here / "cam_dxf.py",
                        Path(cadgen.geometry.contour.__file__), Path(cadgen.machine.hubs.__file__)):
             digest.update(f"{source.name}\0".encode() + source.read_bytes() + b"\0")
         _WRITER.append(digest.hexdigest())

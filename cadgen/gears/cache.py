@@ -5,9 +5,10 @@ Cutting the teeth is the slowest stage of a build, and a designer iterating or a
 over the planter's lengths cuts the same gears again and again. A stage is stored under
 the SHA-256 of everything that determines it (:func:`stage_key`), so an entry is either
 exactly what the computation would give or is never looked up: there is no invalidation
-to get wrong, only keys. The bytes of a gear's DXF file and of the train sheet are stored
-likewise, under the SHA-256 of what they draw and of the writer (:func:`file_key`), so a
-warm build writes its gear files without making them.
+to get wrong, only keys. The bytes of a gear's DXF file, of the train sheet and of the
+cam's file (when the build cut its teeth with this cache) are stored likewise, under the
+SHA-256 of what they draw and of the writer (:func:`file_key`), so a warm build writes its
+cutting files without making them.
 
 Entries are files ``<directory>/<key[:2]>/<key>.gear``: a fixed header (magic, format
 version, the SHA-256 of the payload, the payload's length) and the payload, a pickle

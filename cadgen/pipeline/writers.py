@@ -124,10 +124,13 @@ def _write_cam(run, staging):
 
 def _cam_file(run, path: Path) -> bytes:
     """The cam's DXF bytes (``path`` names it in error messages), made once per run:
-    :func:`prepare` may have made them (and so loaded ezdxf while the worker beside draws)."""
+    :func:`prepare` may have made them. Kept in the gear cache beside the gear files when the
+    build cut its teeth with one (keyed on the contour, the pitch curve, the bore, the chord
+    tolerance and the writers' sources): a warm build never loads ezdxf."""
     made = run.__dict__.setdefault("_cam_file", {})
     if "bytes" not in made:
         from cadgen.export.cam_dxf import cam_dxf_bytes
+        from cadgen.export.train_sheet import _CachedFiles
 
         from cadgen.solids.planting import cam_bore_radius
 
@@ -138,10 +141,17 @@ def _cam_file(run, path: Path) -> bytes:
             from cadgen.machine.drivetrain import drivetrain
 
             shafts = drivetrain(params, run.values["kinematics"])
-        made["bytes"] = cam_dxf_bytes(
-            design.profile.working_profile(points), design.profile.pitch_curve(points),
-            bore_radius=cam_bore_radius(params, shafts),
-            chord_tolerance=params.gears.chord_tolerance, path=path)
+        contour = design.profile.working_profile(points)
+        pitch = design.profile.pitch_curve(points)
+        bore = cam_bore_radius(params, shafts)
+        tolerance = params.gears.chord_tolerance
+        # the teeth's cache (a scene without teeth touches none)
+        cache = getattr(run.values.get("teeth"), "cache", None)
+        made["bytes"] = _CachedFiles(cache, tolerance).get(
+            ("cam dxf", np.asarray(contour, dtype=float), np.asarray(pitch, dtype=float),
+             float(bore)),
+            lambda: cam_dxf_bytes(contour, pitch, bore_radius=bore, chord_tolerance=tolerance,
+                                  path=path))
     return made["bytes"]
 
 
