@@ -58,17 +58,21 @@ def test_cached_builds_write_the_bytes_an_uncached_build_writes(paper, uncached,
     for name, data in uncached.items():
         assert cold_files[name] == data, name
         assert warm_files[name] == data, name
-    # five stages, and the bytes of every gear file (one per gear and the train sheet)
+    # five stages, the bytes of every gear file (one per gear and the train sheet) and each
+    # gear's cutting outline
     dxf = [name for name in uncached if name.startswith("gears/")]
     assert len(_stage_entries(cache)) == 5
-    assert GearCache(cache).stats()[0] == 5 + len(dxf)
+    assert GearCache(cache).stats()[0] == 5 + len(dxf) + (len(dxf) - 1)
 
 
 def _stage_entries(cache: Path) -> list:
-    """The cache's entries holding a cut stage (the others hold a written file's bytes)."""
+    """The cache's entries holding a cut stage (the others hold a written file's bytes or a
+    gear's cutting outline)."""
+    from cadgen.machine.hubs import CuttingOutline
+
     store = GearCache(cache)
     return [entry for entry in sorted(cache.glob("??/*.gear"))
-            if not isinstance(store.get(entry.stem), bytes)]
+            if not isinstance(store.get(entry.stem), (bytes, CuttingOutline))]
 
 
 def test_a_warm_build_writes_the_gear_files_without_making_them(paper, uncached, tmp_path,
@@ -115,6 +119,54 @@ def test_a_warm_build_writes_the_cam_file_without_loading_ezdxf(paper, tmp_path)
            for folder in (tmp_path / "uncached", tmp_path / "cold", tmp_path / "warm")]
     assert cam[0] == cam[1] == cam[2] and cam[0].startswith(b"  0\nSECTION")
     assert alone.report["gear_cache"]["used"] is False and cold.report["gear_cache"]["misses"] == 5
+
+
+def test_a_warm_build_thins_no_gear_outline_again(paper, tmp_path, monkeypatch):
+    """Each bored gear's cutting outline (its solid's, its DXF's and the train sheet's) is
+    kept beside the gear: a warm build of the solids and the cutting files thins none, and
+    its files are the cold build's byte for byte."""
+    import sys
+
+    import cadgen.geometry.contour as contour
+
+    effects, cache = ["teeth", "solids", "dxf", "stl"], tmp_path / "cache"
+    cold = cadgen.build(paper, tmp_path / "cold", effects=effects, cache=cache)
+
+    def never_a_gear(thin):
+        def thinned(*args, **kwargs):   # the cam's contour is thinned for its solid: not a gear
+            caller = sys._getframe(1).f_globals.get("__name__")
+            assert caller != "cadgen.machine.hubs", "a warm build thinned a gear's outline"
+            return thin(*args, **kwargs)
+
+        return thinned
+
+    monkeypatch.setattr(contour, "thin_outline", never_a_gear(contour.thin_outline))
+    monkeypatch.setattr(contour, "thin_ring", never_a_gear(contour.thin_ring))
+    warm = cadgen.build(paper, tmp_path / "warm", effects=effects, cache=cache)
+    assert (warm.report["gear_cache"]["hits"], warm.report["gear_cache"]["misses"]) == (5, 0)
+    cold_files = {f.relative_to(cold.output_dir): f.read_bytes()
+                  for f in sorted(cold.output_dir.rglob("*")) if f.is_file()}
+    warm_files = {f.relative_to(warm.output_dir): f.read_bytes()
+                  for f in sorted(warm.output_dir.rglob("*")) if f.is_file()}
+    assert {str(name) for name in cold_files} >= {"gears/train.dxf", "solids/sun.stl"}
+    for name, data in cold_files.items():
+        if name.name != "report.json":       # stage times, cache hits
+            assert warm_files[name] == data, name
+    # a damaged outline entry is a miss: thinned again (here, by the real thinning) and stored
+    monkeypatch.undo()
+    from cadgen.machine.hubs import CuttingOutline
+
+    store = GearCache(cache)
+    outlines = [entry for entry in sorted(cache.glob("??/*.gear"))
+                if isinstance(store.get(entry.stem), CuttingOutline)]
+    assert len(outlines) == sum(name.parent.name == "gears" for name in cold_files) - 1
+    for victim in outlines:
+        victim.write_bytes(victim.read_bytes()[:-7])
+    again = cadgen.build(paper, tmp_path / "again", effects=effects, cache=cache)
+    for name, data in cold_files.items():
+        if name.name != "report.json":
+            assert (again.output_dir / name).read_bytes() == data, name
+    assert all(isinstance(GearCache(cache).get(v.stem), CuttingOutline) for v in outlines)
 
 
 def test_a_damaged_file_entry_is_made_again(paper, uncached, tmp_path):

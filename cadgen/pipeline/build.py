@@ -301,6 +301,10 @@ def _teeth(run):
                                 key_slot_allowance=fits.key_slot_allowance,
                                 segments=params.solids.segments_per_circle)
         train = dataclasses.replace(train, rims=rims)
+        if {"parts", "dxf"} & ({*run.stages} | {*getattr(run, "effects", ())}):
+            from cadgen.pipeline.gear_cache import remember_cutting_outlines
+
+            remember_cutting_outlines(train, params.gears.chord_tolerance)
     return train
 
 

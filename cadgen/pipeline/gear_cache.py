@@ -11,7 +11,7 @@ import os
 from pathlib import Path
 
 __all__ = ["CACHE_DIR_VARIABLE", "cache_directory", "open_cache", "cache_record", "clear_cache",
-           "cache_info"]
+           "cache_info", "remember_cutting_outlines"]
 
 #: Environment variable naming the gear cache's directory (tests, a shared scratch disk).
 CACHE_DIR_VARIABLE = "CADGEN_CACHE_DIR"
@@ -90,3 +90,37 @@ def cache_info(directory=None) -> dict:
         return {"directory": str(directory), "exists": False, "entries": 0, "bytes": 0}
     entries, size = GearCache(directory, create=False).stats()
     return {"directory": str(directory), "exists": True, "entries": entries, "bytes": size}
+
+
+def remember_cutting_outlines(train, chord_tolerance: float) -> int:
+    """Give each bored gear of ``train`` its cutting outline (thinned to ``chord_tolerance``:
+    :func:`cadgen.machine.hubs.cutting_outline`, which the gear's solid, its DXF file and the
+    train sheet all draw) from the train's gear cache, or thinned here and stored there.
+
+    Keyed as a gear file is (:func:`cadgen.gears.cache.file_key`: the bored profile, the
+    tolerance and the writers' and the thinning's sources), so a warm build thins no outline
+    again. Returns how many were found; none without a cache or a usable tolerance (the
+    stages that need the outline thin it, and say what is wrong with the tolerance).
+    """
+    import math
+
+    cache = getattr(train, "cache", None)
+    tolerance = float(chord_tolerance)
+    if cache is None or not (math.isfinite(tolerance) and tolerance > 0):
+        return 0
+    from cadgen.export.dxf import writer_fingerprint
+    from cadgen.gears.cache import file_key
+    from cadgen.machine.hubs import CuttingOutline, cutting_outline
+
+    writer, found = writer_fingerprint(), 0
+    for profile, *_ in train.gears:
+        key = file_key(("cutting outline", profile), chord_tolerance=tolerance, writer=writer)
+        stored = cache.get(key)
+        if isinstance(stored, CuttingOutline):
+            for array in (stored.outline, stored.pitch):
+                array.setflags(write=False)   # shared by every stage that asks, as computed
+            profile.derived(("cutting outline", tolerance), lambda stored=stored: stored)
+            found += 1
+        else:
+            cache.put(key, cutting_outline(profile, tolerance))
+    return found
