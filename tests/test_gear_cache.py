@@ -441,3 +441,43 @@ def test_batch_no_cache_reaches_each_designs_build(monkeypatch, tmp_path, capsys
         batch.main_batch(parser.parse_args([*argv, "--output-dir", str(tmp_path)]))
     assert seen == [{"cache": False}, None]   # the default leaves a custom build's options be
     capsys.readouterr()
+
+
+@pytest.mark.filterwarnings("ignore:invalid value encountered in linearrings:RuntimeWarning")
+def test_remember_cutting_outlines_stores_loads_and_leaves_a_bad_gear_to_its_writer(tmp_path):
+    """The outline is thinned once and stored, found by the next build's profiles (equal
+    arrays, read-only as computed); a gear whose outline cannot be thinned (a NaN vertex:
+    GEOS refuses it) is skipped, not raised: the DXF writer checks a gear first and names
+    the problem."""
+    from types import SimpleNamespace
+
+    from cadgen.gears.teeth import GearProfile
+    from cadgen.machine.hubs import cutting_outline
+    from cadgen.pipeline.gear_cache import remember_cutting_outlines
+
+    angles = np.linspace(0.0, 2.0 * np.pi, 400, endpoint=False)
+    ring = np.column_stack([10.0 * np.cos(angles), 10.0 * np.sin(angles)])
+    broken = ring.copy()
+    broken[7] = np.nan
+
+    def train():
+        profiles = [GearProfile(name=name, outline=outline, pitch_curve=ring, teeth=20,
+                                module=1.0, bore_radius=2.0)
+                    for name, outline in (("good", ring), ("broken", broken))]
+        return SimpleNamespace(cache=GearCache(tmp_path), gears=[(p, None, None, None)
+                                                                  for p in profiles])
+
+    first = train()
+    assert remember_cutting_outlines(first, 0.005) == 0
+    assert GearCache(tmp_path).stats()[0] == 1          # the good gear's outline only
+    second = train()
+    assert remember_cutting_outlines(second, 0.005) == 1
+    good = second.gears[0][0]
+    loaded = cutting_outline(good, 0.005)                 # from the profile: not thinned again
+    assert not loaded.outline.flags.writeable
+    expected = cutting_outline(first.gears[0][0], 0.005)
+    np.testing.assert_array_equal(loaded.outline, expected.outline)
+    np.testing.assert_array_equal(loaded.pitch, expected.pitch)
+    assert loaded.tolerance_used == expected.tolerance_used
+    assert remember_cutting_outlines(SimpleNamespace(cache=None, gears=[]), 0.005) == 0
+    assert remember_cutting_outlines(train(), float("nan")) == 0

@@ -99,8 +99,9 @@ def remember_cutting_outlines(train, chord_tolerance: float) -> int:
 
     Keyed as a gear file is (:func:`cadgen.gears.cache.file_key`: the bored profile, the
     tolerance and the writers' and the thinning's sources), so a warm build thins no outline
-    again. Returns how many were found; none without a cache or a usable tolerance (the
-    stages that need the outline thin it, and say what is wrong with the tolerance).
+    again. Returns how many were found; none without a cache or a usable tolerance, and a
+    gear whose outline cannot be thinned is left alone (the stages that need the outline
+    thin it, and say what is wrong: the DXF writer checks the gear first).
     """
     import math
 
@@ -122,5 +123,9 @@ def remember_cutting_outlines(train, chord_tolerance: float) -> int:
             profile.derived(("cutting outline", tolerance), lambda stored=stored: stored)
             found += 1
         else:
-            cache.put(key, cutting_outline(profile, tolerance))
+            try:
+                outline = cutting_outline(profile, tolerance)
+            except Exception:   # noqa: BLE001 - a gear its DXF writer refuses: said there
+                continue
+            cache.put(key, outline)
     return found
