@@ -242,8 +242,9 @@ def main(argv=None):
              "our build cuts, checks and meshes five pairs and does everything else. "
              "Issue 15's aims: cold full build <= 0.35 x the peer, metrics only <= 0.05 x. "
              "CPU: user and system time of the command and the worker it forks, median.", "",
-             "| command | median (s) | spread (s) | x peer (medians) | aim | CPU (s) |",
-             "|---|---:|---:|---:|---:|---:|"]
+             "| command | median (s) | spread (s) | x peer (medians) | x peer, each round "
+             "(min-max) | aim | CPU (s) |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
     labels = {"peer": ("ncgears 0.3.1, one pair (the peer)", ""),
               "cold": ("`cadgen build`, every effect, gear cache cold", "0.35"),
               "warm": ("`cadgen build`, every effect, gear cache warm", ""),
@@ -252,10 +253,13 @@ def main(argv=None):
         if not runs:
             continue
         ratio = f"{medians[scene] / peer:.3f}" if peer else "n/a"
+        # the machine's speed drifts within a run: each round's ratio, against its own peer
+        rounds = [mine / theirs for mine, theirs in zip(runs, times["peer"])]
+        each = f"{min(rounds):.3f}-{max(rounds):.3f}" if peer else "n/a"
         label, aim = labels[scene]
         used = f"{statistics.median(cpu[scene]):.2f}" if cpu.get(scene) else ""
-        lines.append(f"| {label} | {medians[scene]:.2f} | {_spread(runs)} | {ratio} | {aim} "
-                     f"| {used} |")
+        lines.append(f"| {label} | {medians[scene]:.2f} | {_spread(runs)} | {ratio} | {each} "
+                     f"| {aim} | {used} |")
     lines += ["", "Stages of the last cold and warm full builds (seconds; the rest of the wall "
               "time is interpreter start, imports and writing the files):", "",
               "| stage | cold (s) | warm (s) |", "|---|---:|---:|"]
