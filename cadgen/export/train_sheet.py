@@ -24,7 +24,7 @@ from cadgen.export.dxf import (CENTRE_MARK_HALF_LENGTH_MODULES, LABEL_GAP_MODULE
                                _text_box, _thin_gear, gear_dxf_bytes, writer_fingerprint)
 from cadgen.geometry.contour import closed_points, ring_measures
 
-__all__ = ["write_train_sheet", "write_train_files", "train_files"]
+__all__ = ["write_train_sheet", "write_train_files", "train_files", "CachedFiles"]
 
 
 def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: float = 0.005,
@@ -266,7 +266,7 @@ def train_files(train, chord_tolerance: float, cache=None, *, folder=Path(".")) 
     profiles = [profile for profile, _, _, _ in train.gears]
     placements = _placements(train)
     planes = _mesh_planes(train, [profile.name for profile, _, _ in placements])
-    files = _CachedFiles(cache, tolerance)
+    files = CachedFiles(cache, tolerance)
     made = []
     for profile in profiles:
         path = folder / f"{profile.file_stem}.dxf"
@@ -299,20 +299,25 @@ def _cut(profile, tolerance: float):
     return cut.outline, cut.tolerance_used, cut.pitch
 
 
-class _CachedFiles:
-    """A written file's bytes from the gear cache, or made and stored there (no cache: made)."""
+class CachedFiles:
+    """What the cutting files are made from and of, from the gear cache, or made and stored
+    there (no cache: made): a file's bytes, a gear's thinned cutting outline. Keyed by
+    :func:`cadgen.gears.cache.file_key` on the inputs, the chord tolerance and the writers'
+    fingerprint (:func:`cadgen.export.dxf.writer_fingerprint`)."""
 
     def __init__(self, cache, tolerance: float):
         self.cache, self.tolerance = cache, tolerance
 
-    def get(self, inputs, make) -> bytes:
+    def get(self, inputs, make, kind=bytes):
+        """The stored value of ``inputs`` if it is a ``kind`` (an entry of another kind, or
+        a damaged one, is no entry), else ``make()``, stored."""
         if self.cache is None:
             return make()
         from cadgen.gears.cache import file_key
 
         key = file_key(inputs, chord_tolerance=self.tolerance, writer=writer_fingerprint())
         stored = self.cache.get(key)
-        if isinstance(stored, bytes):
+        if isinstance(stored, kind):
             return stored
         data = make()
         self.cache.put(key, data)

@@ -97,11 +97,12 @@ def remember_cutting_outlines(train, chord_tolerance: float) -> int:
     :func:`cadgen.machine.hubs.cutting_outline`, which the gear's solid, its DXF file and the
     train sheet all draw) from the train's gear cache, or thinned here and stored there.
 
-    Keyed as a gear file is (:func:`cadgen.gears.cache.file_key`: the bored profile, the
-    tolerance and the writers' and the thinning's sources), so a warm build thins no outline
-    again. Returns how many were found; none without a cache or a usable tolerance, and a
-    gear whose outline cannot be thinned is left alone (the stages that need the outline
-    thin it, and say what is wrong: the DXF writer checks the gear first).
+    Kept as a gear file is (:class:`cadgen.export.train_sheet.CachedFiles`: keyed on the
+    bored profile, the tolerance and the writers' and the thinning's sources), so a warm
+    build thins no outline again. Returns how many were found; none without a cache or a
+    usable tolerance, and a gear whose outline cannot be thinned is left alone (the stages
+    that need the outline thin it, and say what is wrong: the DXF writer checks the gear
+    first).
     """
     import math
 
@@ -109,23 +110,21 @@ def remember_cutting_outlines(train, chord_tolerance: float) -> int:
     tolerance = float(chord_tolerance)
     if cache is None or not (math.isfinite(tolerance) and tolerance > 0):
         return 0
-    from cadgen.export.dxf import writer_fingerprint
-    from cadgen.gears.cache import file_key
+    from cadgen.export.train_sheet import CachedFiles
     from cadgen.machine.hubs import CuttingOutline, cutting_outline
 
-    writer, found = writer_fingerprint(), 0
+    files, found = CachedFiles(cache, tolerance), 0
     for profile, *_ in train.gears:
-        key = file_key(("cutting outline", profile), chord_tolerance=tolerance, writer=writer)
-        stored = cache.get(key)
-        if isinstance(stored, CuttingOutline):
-            for array in (stored.outline, stored.pitch):
-                array.setflags(write=False)   # shared by every stage that asks, as computed
-            profile.derived(("cutting outline", tolerance), lambda stored=stored: stored)
+        hits = cache.hits
+        try:
+            cut = files.get(("cutting outline", profile),
+                            lambda profile=profile: cutting_outline(profile, tolerance),
+                            kind=CuttingOutline)
+        except Exception:   # noqa: BLE001 - a gear its DXF writer refuses: said there
+            continue
+        if cache.hits > hits:   # read back: read-only as computed, the profile's from now on
+            for array in (cut.outline, cut.pitch):
+                array.setflags(write=False)
+            profile.derived(("cutting outline", tolerance), lambda cut=cut: cut)
             found += 1
-        else:
-            try:
-                outline = cutting_outline(profile, tolerance)
-            except Exception:   # noqa: BLE001 - a gear its DXF writer refuses: said there
-                continue
-            cache.put(key, outline)
     return found

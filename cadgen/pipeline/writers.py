@@ -130,7 +130,7 @@ def _cam_file(run, path: Path) -> bytes:
     made = run.__dict__.setdefault("_cam_file", {})
     if "bytes" not in made:
         from cadgen.export.cam_dxf import cam_dxf_bytes
-        from cadgen.export.train_sheet import _CachedFiles
+        from cadgen.export.train_sheet import CachedFiles
 
         from cadgen.solids.planting import cam_bore_radius
 
@@ -147,7 +147,7 @@ def _cam_file(run, path: Path) -> bytes:
         tolerance = params.gears.chord_tolerance
         # the teeth's cache (a scene without teeth touches none)
         cache = getattr(run.values.get("teeth"), "cache", None)
-        made["bytes"] = _CachedFiles(cache, tolerance).get(
+        made["bytes"] = CachedFiles(cache, tolerance).get(
             ("cam dxf", np.asarray(contour, dtype=float), np.asarray(pitch, dtype=float),
              float(bore)),
             lambda: cam_dxf_bytes(contour, pitch, bore_radius=bore, chord_tolerance=tolerance,
