@@ -56,21 +56,25 @@ def prepare(run) -> int:
         for _ in solids_files(outcome):
             made += 1
     if "dxf" in run.effects and run.status("teeth") == "ok" and run.values["teeth"].stages:
-        try:
-            _gear_files(run, Path("gears"))
-            made += 1
-        except Exception:   # said again, with the staging folder's paths, when written
-            run.__dict__.pop("_gear_files", None)
+        made += _made_ahead(run, "_gear_files", lambda: _gear_files(run, Path("gears")))
     if "dxf" in run.effects and run.status("cam") == "ok" and run.values["cam"].cuttable:
-        try:
-            _cam_file(run, Path("cam.dxf"))
-            made += 1
-        except Exception:   # said again, with the staging folder's path, when written
-            run.__dict__.pop("_cam_file", None)
+        made += _made_ahead(run, "_cam_file", lambda: _cam_file(run, Path("cam.dxf")))
     if "report" in run.effects:
         animation_of(run)
         made += 1
     return made
+
+
+def _made_ahead(run, memo: str, make) -> int:
+    """1 when ``make()`` made a cutting file ahead of the writing (remembered in the run's
+    ``memo``), else 0 and nothing remembered: a failure is said again, with the staging
+    folder's path, when the file is written."""
+    try:
+        make()
+    except Exception:   # noqa: BLE001 - raised again by the writing, with its path
+        run.__dict__.pop(memo, None)
+        return 0
+    return 1
 
 
 def animation_of(run) -> dict:
