@@ -99,3 +99,27 @@ def test_the_building_process_takes_the_workers_meshes_of_the_gearless_parts(tmp
     # every part has its mesh, and each its STL
     assert all(p._mesh is not None for p in assemblies[0].parts)
     assert {f.stem for f in (result.output_dir / "solids").glob("*.stl")} >= set(parts)
+
+
+def test_a_cutting_file_that_fails_ahead_is_said_by_the_writing_with_its_path(tmp_path,
+                                                                              monkeypatch):
+    """The building process makes the cam's file while the worker draws; a failure there is
+    not kept: the writing makes it again and raises, naming the file in the staging folder,
+    and no output folder is left (the build writes all or nothing)."""
+    import cadgen.export.cam_dxf as cam_dxf
+    from cadgen.export.dxf import DxfExportError
+
+    asked = []
+
+    def refused(*args, path, **kwargs):
+        asked.append(str(path))
+        raise DxfExportError(f"{path}: refused here")
+
+    monkeypatch.setattr(cam_dxf, "cam_dxf_bytes", refused)
+    params = load_params(ROOT / "params" / "xin2024-planter.toml")
+    with pytest.raises(DxfExportError) as raised:
+        build(params, tmp_path, cache=False)
+    assert asked[0] == "cam.dxf"                        # made ahead, while the worker drew
+    assert len(asked) == 2 and asked[1].endswith("/cam.dxf") and asked[1] != "cam.dxf"
+    assert asked[1] in str(raised.value)                # the writing's own path, in the error
+    assert not (tmp_path / params.name).exists()
