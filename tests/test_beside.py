@@ -55,13 +55,16 @@ def test_a_build_with_the_worker_beside_equals_one_in_one_process(path, tmp_path
     assert files == _files(alone.output_dir)
 
 
-def test_the_building_process_takes_the_workers_meshes_of_the_gearless_parts(tmp_path,
+@pytest.mark.parametrize("effects", [None, ["teeth", "stl"]], ids=["every-effect", "solids-only"])
+def test_the_building_process_takes_the_workers_meshes_of_the_gearless_parts(effects, tmp_path,
                                                                               monkeypatch):
     """The worker meshes the gearless parts for its sweeps and sends them back first: the
     building process (this one) must not mesh them again for the assembly view and the
     solids' files (a quarter of a second of the paper design's CPU, made twice before), even
     when the worker's sweeps are far from done (made slow here: the worker is forked from
-    this process, so it runs the patched stage)."""
+    this process, so it runs the patched stage). A scene of solids without sweeps or figures
+    meshes them beside the teeth too (it once left the second core idle and took longer than
+    the scene with the sweeps), and writes the same files as one process."""
     import importlib
     import time
 
@@ -88,8 +91,10 @@ def test_the_building_process_takes_the_workers_meshes_of_the_gearless_parts(tmp
     monkeypatch.setattr(beside, "take_meshes", taking)
     monkeypatch.setitem(cadgen.pipeline.build.STAGE_FUNCTIONS, "arm_interference", slow)
     params = load_params(ROOT / "params" / "xin2024-planter.toml")
-    result = build(params, tmp_path)       # every effect: the STLs need every mesh too
-    assert any("second process" in r["message"] for r in result.report["stages"])
+    # every effect: the STLs need every mesh too
+    result = build(params, tmp_path / "forked", effects=effects)
+    assert any("second process" in r["message"] for r in result.report["stages"]) \
+        == (effects is None)
     kinds = beside.gearless_kinds(params.mechanism)
     parts = {p.name: p.kind for p in assemblies[0].parts}
     gearless = {name for name, kind in parts.items() if kind in kinds}
@@ -99,6 +104,10 @@ def test_the_building_process_takes_the_workers_meshes_of_the_gearless_parts(tmp
     # every part has its mesh, and each its STL
     assert all(p._mesh is not None for p in assemblies[0].parts)
     assert {f.stem for f in (result.output_dir / "solids").glob("*.stl")} >= set(parts)
+    if effects is not None:
+        monkeypatch.setattr(cadgen.pipeline.figures, "_can_fork", lambda: False)
+        alone = build(params, tmp_path / "alone", effects=effects)
+        assert _files(result.output_dir) == _files(alone.output_dir)
 
 
 def test_a_cutting_file_that_fails_ahead_is_said_by_the_writing_with_its_path(tmp_path,

@@ -31,7 +31,7 @@ def params():
     (["arm_interference"], ["kinematics", "metrics", "cam", "drivetrain", "parts",
                             "arm_interference"]),
     (["ground_clearance"], ["kinematics", "metrics", "drivetrain", "parts", "ground_clearance"]),
-    (["plots"], ["kinematics", "plots"]),
+    (["plots"], ["kinematics", "metrics", "plots"]),
 ])
 def test_each_effect_needs_exactly_its_stages(effects, stages):
     assert plan(effects)[0] == stages
@@ -140,6 +140,23 @@ def test_pricking_build_runs_its_own_stages(tmp_path):
     # kernel-a's gears are concave: the design does not pass, and says why
     assert not result.report["passed"]
     assert any("concave" in f for f in result.report["failures"])
+
+
+@pytest.mark.parametrize("design, figures", [
+    (REFERENCE, {"relative_path.png", "absolute_paths.png", "attitude.png", "tip_velocity.png",
+                 "pitch_curves.png"}),
+    (KERNEL_A, {"loop.png", "pitch_curves.png", "ratio.png", "field_paths.png"}),
+])
+def test_plots_asked_alone_draw_the_motion_figures(design, figures, tmp_path):
+    # the motion figures are drawn from the metrics' events: "plots" alone once ran the
+    # kinematics only, drew nothing and said "ok"
+    result = build(load_params(design), tmp_path, effects=["plots"])
+    stages = {s["stage"]: s["status"] for s in result.report["stages"]}
+    assert stages == {"kinematics": "ok", "metrics": "ok", "plots": "ok"}
+    written = {p.name for p in (tmp_path / design.stem / "plots").iterdir()}
+    assert written == figures
+    assert all((tmp_path / design.stem / "plots" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+               for name in written)
 
 
 def test_sweeps_replace_the_kinematic_estimates_and_keep_them_beside(params):

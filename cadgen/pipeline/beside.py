@@ -3,10 +3,10 @@ show no gear, while the building process cuts the gears.
 
 On a machine with a second core and the fork start method, :func:`start_beside` forks one
 worker when the teeth stage begins. The worker inherits every value computed so far (nothing
-is pickled on the way in), builds and meshes the gearless parts (only where the housings do
-not depend on the gears: the assembly module's ``GEARLESS_KINDS``) and sends their meshes
-back at once, runs the FCL sweeps on them, then draws figures that show no gear; its results
-come back pickled (meshes, sweep records and values, PNG bytes). The building process cuts
+is pickled on the way in), builds and meshes the gearless parts (the assembly module's
+``GEARLESS_KINDS``; whenever parts follow, even in a scene without sweeps or figures) and
+sends their meshes back at once, runs the FCL sweeps on them, then draws figures that show
+no gear; its results come back pickled (meshes, sweep records and values, PNG bytes). The building process cuts
 the teeth, builds the parts with the gears, takes the worker's meshes (drawing gear pairs'
 figures while they are not there yet) for the assembly view and the solids' files
 (:func:`plots_beside`), then shares the rest: the worker's gearless figures and
@@ -84,7 +84,10 @@ def start_beside(run, functions):
     sweeps = tuple(s for s in SWEEP_STAGES if s in run.stages
                    and "housing" in gearless_kinds(run.params.mechanism))
     figures = "plots" in run.stages
-    if not (sweeps or figures) or "teeth" not in run.stages or not _can_fork() \
+    # the gearless parts are meshed there whenever parts follow: a scene of solids without
+    # sweeps or figures once left the second core idle and took longer than one with them
+    parts = "parts" in run.stages and bool(gearless_kinds(run.params.mechanism))
+    if not (sweeps or figures or parts) or "teeth" not in run.stages or not _can_fork() \
             or any(r.status != "ok" for r in run.records):
         return None
     from concurrent.futures import ProcessPoolExecutor
@@ -102,7 +105,7 @@ def start_beside(run, functions):
     ends = run.progress.pipe()
     context = multiprocessing.get_context("fork")
     taken, pool, pool_key = context.Value("i", 0), context.Value("i", 0), context.Value("q", -1)
-    _BESIDE.update(run=run, functions=functions, sweeps=sweeps, figures=figures,
+    _BESIDE.update(run=run, functions=functions, sweeps=sweeps, figures=figures, parts=parts,
                    events=ends[1] if ends else None, taken=taken, pool=pool, pool_key=pool_key)
     executor = ProcessPoolExecutor(1, mp_context=context)
     try:
@@ -120,16 +123,17 @@ def start_beside(run, functions):
 def _beside_parts() -> dict:
     """In the forked worker, first: the gearless parts, every one meshed (the sweeps need
     most; the building process all, for the assembly view and the solids' files), sent back
-    before the sweeps. ``{part name: (vertices, faces)}``, empty if the parts failed (their
-    record is then the worker's, and the sweeps are skipped).
+    before the sweeps; made whenever parts follow the teeth, sweeps or not.
+    ``{part name: (vertices, faces)}``, empty if the parts failed (their record is then the
+    worker's, and the sweeps are skipped).
     """
     run, events, progress = _BESIDE["run"], _BESIDE.get("events"), _BESIDE["run"].progress
     if events is not None:
         progress.forward(events)
-    if not _BESIDE["sweeps"]:
+    if not _BESIDE["parts"]:
         return {}
     try:
-        progress.started("parts", detail="without gears, for the sweeps", beside=True)
+        progress.started("parts", detail="the gearless ones, beside the teeth", beside=True)
         start = time.perf_counter()
         record, parts = _run_stage(run, "parts", {"parts": _gearless_parts})
         meshes = {}
@@ -139,11 +143,15 @@ def _beside_parts() -> dict:
             meshes = {part.name: (part.mesh.vertices, part.mesh.faces)
                       for part in parts.assembly.parts if part.kind in kinds}
             record.seconds = time.perf_counter() - start
-            run.values["parts"] = parts
-            run.records.append(record)
+            if _BESIDE["sweeps"]:
+                # the sweeps run on them, and the housing figures drawn here show them: only
+                # where the housings are gearless (else this side's housings are not the
+                # build's: the pricking gear case is drawn round the gears)
+                run.values["parts"] = parts
+                run.records.append(record)
         _BESIDE["parts_record"] = record
         progress.finished("parts", record.status, record.seconds,
-                          detail=record.message or "without gears, for the sweeps", beside=True)
+                          detail=record.message or "the gearless ones, beside the teeth", beside=True)
         return meshes
     except BaseException:
         _BESIDE["failed"] = True    # the next tasks compute nothing

@@ -72,7 +72,10 @@ EFFECT_STAGES = {
     "ground_clearance": ("metrics", "parts", "ground_clearance"),
     "dxf": (),                 # the cutting files of the teeth and cam that run (both if alone)
     "stl": ("cam", "parts"),
-    "plots": ("plots",),
+    # the trajectory, attitude and speed figures are drawn from the metrics' events (soil
+    # line, holes); the plots stage itself needs only the kinematics, so that the gears'
+    # figures are still drawn when the metrics fail
+    "plots": ("metrics", "plots"),
     "report": (),
 }
 
