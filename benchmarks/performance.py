@@ -19,7 +19,9 @@ Run:  python -m benchmarks.performance [--output docs/performance.md] [--quick]
    against a reference (the certified sweep at ``atol`` 1e-10 mm): time, ratio, error.
 3. **Accuracy presets**: the full build (gear cache cold) at ``--preset`` draft, standard
    (the default) and fine, three runs each: what the README's preset table quotes.
-4. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
+4. **What each effect costs**: scenes from metrics only to every effect, each adding
+   effects to the one before (gear cache cold, five interleaved runs).
+5. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
    design (every effect), on 1 and on 2 worker processes: designs per minute and
    the speed-up.
 
@@ -178,6 +180,38 @@ def preset_table(root: Path, runs: int = 3) -> list:
     return rows
 
 
+#: Scenes, each adding effects to the one before: what each effect costs in a build of the
+#: paper's design (the last is every effect).
+SCENES = (("metrics", "metrics"),
+          ("+ teeth (five pairs cut, checked)", "metrics,teeth"),
+          ("+ dxf (cutting files)", "metrics,teeth,dxf"),
+          ("+ solids, stl (parts, STLs, assembly)", "metrics,teeth,dxf,solids,stl"),
+          ("+ arm_interference, ground_clearance (FCL sweeps)",
+           "metrics,teeth,dxf,solids,stl,arm_interference,ground_clearance"),
+          ("+ report (report.html)",
+           "metrics,teeth,dxf,solids,stl,arm_interference,ground_clearance,report"),
+          ("+ plots (every effect)",
+           "metrics,teeth,dxf,solids,stl,arm_interference,ground_clearance,report,plots"))
+
+
+def scene_table(root: Path, runs: int = 5) -> list:
+    """``[(label, effects, median wall s, spread, median CPU s)]``: the scenes of
+    :data:`SCENES`, gear cache cold, interleaved (one run of each scene per round)."""
+    walls = {effects: [] for _, effects in SCENES}
+    cpus = {effects: [] for _, effects in SCENES}
+    for _ in range(runs):
+        for _, effects in SCENES:
+            _empty_cache()
+            walls[effects].append(_cadgen("build", str(PARAMS), "--effects", effects,
+                                          "--output-dir", str(root / "scenes")))
+            cpus[effects].append(_CPU[-1])
+    rows = [(label, effects, statistics.median(walls[effects]), _spread(walls[effects]),
+             statistics.median(cpus[effects])) for label, effects in SCENES]
+    for label, _, wall, _, used in rows:
+        print(f"scene {label}: {wall:.2f} s, CPU {used:.2f} s", flush=True)
+    return rows
+
+
 GRID = """base = "{base}"
 name = "perf"
 [grid]
@@ -225,6 +259,7 @@ def main(argv=None):
         times = interleaved_rounds(root, 1 if args.quick else args.rounds, peer_python)
         sweeps = [] if args.quick else sweep_table()
         presets = [] if args.quick else preset_table(root)
+        scenes = [] if args.quick else scene_table(root)
         batch = [] if args.quick else batch_table(root)
     stages, cpu = times.pop("stages"), times.pop("cpu")
     medians = {scene: statistics.median(runs) for scene, runs in times.items() if runs}
@@ -284,6 +319,17 @@ def main(argv=None):
                   "| preset | median (s) | spread (s) | CPU (s) |", "|---|---:|---:|---:|"]
         lines += [f"| {preset} | {wall:.2f} | {spread} | {used:.2f} |"
                   for preset, wall, spread, used in presets]
+    if scenes:
+        lines += ["", "## What each effect costs", "",
+                  "The paper's design, gear cache cold, each scene adding effects to the one "
+                  "above (`--effects`; five interleaved runs, median). A scene runs only the "
+                  "stages its effects need (README, \"Scenes\"); the second core works beside "
+                  "the teeth once parts, sweeps or figures follow them.", "",
+                  "| scene | median (s) | spread (s) | added (s) | CPU (s) |",
+                  "|---|---:|---:|---:|---:|"]
+        for index, (label, effects, wall, spread, used) in enumerate(scenes):
+            added = f"{wall - scenes[index - 1][2]:+.2f}" if index else ""
+            lines.append(f"| {label} | {wall:.2f} | {spread} | {added} | {used:.2f} |")
     if batch:
         lines += ["", "## Batch throughput", "",
                   "`cadgen batch` over a grid of 4 variants of the paper's design (L2 = 186 to "

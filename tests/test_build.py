@@ -32,6 +32,7 @@ def params():
                             "arm_interference"]),
     (["ground_clearance"], ["kinematics", "metrics", "drivetrain", "parts", "ground_clearance"]),
     (["plots"], ["kinematics", "metrics", "plots"]),
+    (["report"], ["kinematics", "metrics"]),
 ])
 def test_each_effect_needs_exactly_its_stages(effects, stages):
     assert plan(effects)[0] == stages
@@ -157,6 +158,32 @@ def test_plots_asked_alone_draw_the_motion_figures(design, figures, tmp_path):
     assert written == figures
     assert all((tmp_path / design.stem / "plots" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
                for name in written)
+
+
+def test_a_scene_none_of_whose_effects_applies_is_refused_and_writes_nothing(tmp_path, capsys):
+    # it once ran no stage and said PASSED of nothing
+    from cadgen.params import ParameterError
+
+    with pytest.raises(ParameterError) as caught:
+        build(load_params(KERNEL_A), tmp_path / "out", effects=["cam", "arm_interference"])
+    [problem] = caught.value.problems
+    assert (problem.path, problem.code) == ("scene.effects", "nothing_to_build")
+    assert "the pricking mechanism has no cam" in problem.message
+    assert "the pricking mechanism has a single arm" in problem.message
+    assert main(["build", str(KERNEL_A), "--effects", "cam", "--output-dir",
+                 str(tmp_path / "out")]) == 2
+    assert "scene.effects" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_report_asked_alone_holds_the_metrics_it_judges(tmp_path):
+    # it once ran no stage, wrote a report of nothing and said PASSED
+    result = build(load_params(REFERENCE), tmp_path, effects=["report"])
+    assert [s["stage"] for s in result.report["stages"]] == ["kinematics", "metrics"]
+    metrics = {m["key"] for m in result.report["metrics"]}
+    assert {"trajectory_height", "hole_width", "module"} <= metrics
+    html = (tmp_path / REFERENCE.stem / "report.html").read_text(encoding="utf-8")
+    assert "trajectory height" in html
 
 
 def test_sweeps_replace_the_kinematic_estimates_and_keep_them_beside(params):

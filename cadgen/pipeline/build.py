@@ -76,7 +76,9 @@ EFFECT_STAGES = {
     # line, holes); the plots stage itself needs only the kinematics, so that the gears'
     # figures are still drawn when the metrics fail
     "plots": ("metrics", "plots"),
-    "report": (),
+    # the report's verdict is the metrics against the targets: asked alone it once ran no
+    # stage at all and said PASSED of nothing
+    "report": ("metrics",),
 }
 
 #: Each stage's own needs, and the order stages run in.
@@ -424,7 +426,9 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         read-only or virtual filesystem, an existing ``<output_root>/<name>`` file).
     cadgen.params.ParameterError
         Before any stage runs, when a problem validation found belongs to a stage
-        the scene runs (see :func:`stage_warnings`); of other stages, warnings.
+        the scene runs (see :func:`stage_warnings`); of other stages, warnings. Also when
+        no effect of the scene applies to the design (``scene.effects``,
+        ``nothing_to_build``).
     """
     from cadgen.params.scene import apply_preset
 
@@ -439,6 +443,8 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     effects = tuple(effects) if effects is not None else scene.effects
     case = case or scene.case
     stages, set_aside = plan(effects, params.mechanism, case)
+    if not stages:
+        _nothing_to_build(set_aside)
     warnings = stage_warnings(params, stages)
     run = _Build(params, stages, steps, progress)
     run.warnings = warnings
@@ -454,6 +460,18 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         if output_root is None:
             return BuildResult(params.name, report, None)
         return _write(run, Path(output_root) / params.name)
+
+
+def _nothing_to_build(set_aside: dict) -> None:
+    """Refuse a scene none of whose effects applies to the design (a cam asked of the pricking
+    mechanism): its build would run no stage and say PASSED of nothing."""
+    from cadgen.params import ParameterError
+    from kinematics.errors import Problem
+
+    reasons = "; ".join(f"{effect}: {reason}" for effect, reason in set_aside.items())
+    raise ParameterError([Problem("scene.effects", "nothing_to_build",
+                                  "no effect of the scene applies to this design"
+                                  + (f" ({reasons})" if reasons else ""))])
 
 
 @contextlib.contextmanager
