@@ -258,7 +258,7 @@ def test_png_writer_refuses_what_is_not_rgb():
 # The figures of real designs
 
 
-def _build_figures(path, stages, monkeypatch):
+def _build_figures(path, stages, monkeypatch, case="field"):
     """``{name: drawn figure}`` of a design built up to ``stages`` (the figures kept)."""
     import cadgen.pipeline.build
     import cadgen.report.plots.base as base
@@ -266,7 +266,7 @@ def _build_figures(path, stages, monkeypatch):
     from cadgen.pipeline.figures import figure_jobs
 
     run = cadgen.pipeline.build._Build(load_params(path), stages, None)
-    run.effects, run.case = ["plots"], "field"
+    run.effects, run.case = ["plots"], case
     run.run(cadgen.pipeline.build.STAGE_FUNCTIONS)
     drawn = []
 
@@ -295,4 +295,33 @@ def test_the_figures_of_a_design_keep_their_texts_inside_and_apart(design, monke
     figures = _build_figures(REFERENCE.parent / file, stages, monkeypatch)
     assert len(figures) == count
     for name, figure in figures.items():
+        assert_texts_clear(figure, name)
+
+
+def _words(figure) -> str:
+    """Every text of a figure and every legend label, lower case, as one string."""
+    texts = [t.get_text() for t in _decorations(figure)]
+    for legend in [*figure.legends, *(ax.get_legend() for ax in figure.axes)]:
+        if legend is not None:
+            texts += [t.get_text() for t in legend.get_texts()]
+    return " ".join(texts).lower()
+
+
+@pytest.mark.parametrize("design, field_only", [("planting", {"absolute_paths.png"}),
+                                                ("pricking", {"field_paths.png"})])
+def test_a_bench_run_draws_no_soil(design, field_only, monkeypatch):
+    """A bench run's report leaves out what needs soil; its figures did show the soil line,
+    soil entry and exit, hole widths and absolute paths all the same."""
+    from helpers import REFERENCE
+
+    file, stages, count = DESIGNS[design]
+    field = _build_figures(REFERENCE.parent / file, stages, monkeypatch)
+    bench = _build_figures(REFERENCE.parent / file, stages, monkeypatch, case="bench")
+    assert set(bench) == set(field) - field_only
+    # the field figures say these words, so the check below can fail
+    assert any("soil" in _words(figure) for figure in field.values())
+    for name, figure in bench.items():
+        words = _words(figure)
+        for word in ("soil", "entry", "exit", "hole", "absolute", "s = "):
+            assert word not in words, (name, word)
         assert_texts_clear(figure, name)

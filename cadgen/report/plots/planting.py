@@ -9,12 +9,16 @@ __all__ = ["planting_figures", "planting_figure_jobs"]
 from cadgen.report.plots.base import _event_ticks, _figure, _legend_below, _png  # noqa: E402
 
 
-def _events_deg(evaluation):
+def _events_deg(evaluation, soil: bool = True):
+    """The events to mark (rad): soil entry, lowest point, exit; a bench run (no soil) has
+    only the lowest point."""
     ev = evaluation.events
+    if not soil:
+        return {"lowest": ev.lowest}
     return {"entry": ev.entry, "lowest": ev.lowest, "exit": ev.exit}
 
 
-def relative_path(mechanism, evaluation, phi):
+def relative_path(mechanism, evaluation, phi, soil: bool = True):
     figure, ax = _figure(5.5, 8.0)
     for arm, colour in ((0, "tab:blue"), (1, "tab:orange")):
         tip = mechanism.motion(phi, "N", arm).position
@@ -29,7 +33,9 @@ def relative_path(mechanism, evaluation, phi):
         centre = mechanism.motion(np.array([0.0]), circle.point).position[0]
         ax.add_patch(__import__("matplotlib.patches", fromlist=["Circle"]).Circle(
             centre, circle.radius, fill=False, ls=":", color="0.4"))
-    ax.axhline(evaluation.events.soil_level, color="saddlebrown", lw=1.5, label="soil surface")
+    if soil:
+        ax.axhline(evaluation.events.soil_level, color="saddlebrown", lw=1.5,
+                   label="soil surface")
     ax.plot([], [], ":", color="0.4", label="gearbox 2 housing circles")
     ax.plot([], [], "-o", color="0.5", ms=4, label="carrier O-C, arm C-E-P1-N")
     ax.plot([0], [0], "k+", ms=12)
@@ -63,12 +69,13 @@ def absolute_paths(mechanism, evaluation, phi):
     return _png(figure)
 
 
-def attitude(mechanism, evaluation, phi):
+def attitude(mechanism, evaluation, phi, soil: bool = True):
     figure, ax = _figure()
     ax.plot(np.degrees(phi), np.degrees(mechanism.attitude(phi)), lw=1.4, color="tab:blue",
             label="attitude Psi")
-    events = _events_deg(evaluation)
-    for (name, angle), colour in zip(events.items(), ("tab:orange", "tab:green", "tab:red")):
+    events = _events_deg(evaluation, soil)
+    colours = ("tab:orange", "tab:green", "tab:red") if soil else ("tab:green",)
+    for (name, angle), colour in zip(events.items(), colours):
         value = np.degrees(mechanism.attitude(np.array([angle]))[0])
         ax.plot(np.degrees(angle), value, "o", color=colour,
                 label=f"{name}: {value:.2f} deg at phi = {np.degrees(angle):.1f} deg")
@@ -82,23 +89,24 @@ def attitude(mechanism, evaluation, phi):
     return _png(figure)
 
 
-def velocity(mechanism, evaluation, phi):
+def velocity(mechanism, evaluation, phi, soil: bool = True):
     figure, ax = _figure()
     omega = 2 * np.pi * evaluation.carrier_speed_rpm / 60.0
     v = mechanism.motion(phi, "N").velocity * omega
     ax.plot(np.degrees(phi), np.hypot(v[:, 0], v[:, 1]), lw=1.4, label="relative speed |v|")
-    for hole in evaluation.holes:
+    for hole in evaluation.holes if soil else ():    # no forward travel on a bench
         drift = hole.spacing / np.pi * omega
         ax.plot(np.degrees(phi), np.hypot(v[:, 0] + drift, v[:, 1]), lw=1.0,
                 label=f"absolute speed, S = {hole.spacing:g} mm")
-    events = {name: np.degrees(angle) for name, angle in _events_deg(evaluation).items()}
+    events = {name: np.degrees(angle) for name, angle in _events_deg(evaluation, soil).items()}
     for angle in events.values():
         ax.axvline(angle, color="0.6", ls=":")
     _event_ticks(ax, events)
     ax.set_xlim(0, 360)
     ax.set_xlabel("carrier angle phi (deg)")
     ax.set_ylabel(f"tip speed (mm/s at {evaluation.carrier_speed_rpm:g} r/min)")
-    ax.set_title("Tip speed (dotted: soil entry, lowest point, exit)")
+    ax.set_title("Tip speed (dotted: soil entry, lowest point, exit)" if soil else
+                 "Tip speed on the bench (dotted: lowest point)")
     _legend_below(figure, ncols=2)
     ax.grid(alpha=0.3)
     return _png(figure)
@@ -126,16 +134,24 @@ def pitch_curves(mechanism, evaluation, samples=1440):
     return _png(figure)
 
 
-def planting_figure_jobs(mechanism, evaluation, samples: int = 1441) -> dict:
-    """``{file name: callable -> PNG bytes}`` of every plot of a planting design."""
+def planting_figure_jobs(mechanism, evaluation, samples: int = 1441, *,
+                         soil: bool = True) -> dict:
+    """``{file name: callable -> PNG bytes}`` of every plot of a planting design.
+
+    ``soil=False`` (a bench run, whose report leaves out what needs soil): no absolute
+    paths, and no soil line, soil entry and exit or absolute speeds on the others.
+    """
     phi = np.linspace(0.0, 2 * np.pi, samples)
-    return {
-        "relative_path.png": lambda: relative_path(mechanism, evaluation, phi),
+    jobs = {
+        "relative_path.png": lambda: relative_path(mechanism, evaluation, phi, soil),
         "absolute_paths.png": lambda: absolute_paths(mechanism, evaluation, phi),
-        "attitude.png": lambda: attitude(mechanism, evaluation, phi),
-        "tip_velocity.png": lambda: velocity(mechanism, evaluation, phi),
+        "attitude.png": lambda: attitude(mechanism, evaluation, phi, soil),
+        "tip_velocity.png": lambda: velocity(mechanism, evaluation, phi, soil),
         "pitch_curves.png": lambda: pitch_curves(mechanism, evaluation),
     }
+    if not soil:
+        del jobs["absolute_paths.png"]
+    return jobs
 
 
 def planting_figures(mechanism, evaluation, samples: int = 1441) -> dict:

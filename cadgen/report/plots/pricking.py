@@ -139,11 +139,14 @@ def field_paths(design, field, params):
     return _png(figure)
 
 
-def pricking_figure_jobs(params, design, field) -> dict:
-    """``{file name: callable -> PNG bytes}`` of every plot of a pricking design."""
-    return {"loop.png": lambda: loop(design), "pitch_curves.png": lambda: pitch_curves(design),
-            "ratio.png": lambda: ratio(design),
-            "field_paths.png": lambda: field_paths(design, field, params)}
+def pricking_figure_jobs(params, design, field, *, soil: bool = True) -> dict:
+    """``{file name: callable -> PNG bytes}`` of every plot of a pricking design; a bench run
+    (``soil=False``, whose report leaves out what needs soil) has no field paths."""
+    jobs = {"loop.png": lambda: loop(design), "pitch_curves.png": lambda: pitch_curves(design),
+            "ratio.png": lambda: ratio(design)}
+    if soil:
+        jobs["field_paths.png"] = lambda: field_paths(design, field, params)
+    return jobs
 
 
 def pricking_figures(params, design, field) -> dict:
