@@ -176,6 +176,20 @@ def test_bad_parameters_start_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_scene_none_of_whose_effects_applies_starts_nothing(tmp_path):
+    # what `cadgen build` refuses (exit 2) is refused here before a process starts
+    jobs = BuildJobs(tmp_path)
+    data = fast_params()
+    data["scene"] = {"effects": ["ground_clearance"], "case": "bench"}
+    with pytest.raises(cadgen.ParameterError) as refused:
+        jobs.start(data)
+    assert [(p.path, p.code) for p in refused.value.problems] == [("scene.effects",
+                                                                   "nothing_to_build")]
+    assert "a bench run has no soil" in refused.value.problems[0].message
+    assert jobs._jobs == {}
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_an_unknown_job(tmp_path):
     jobs = BuildJobs(tmp_path)
     with pytest.raises(UnknownJob):

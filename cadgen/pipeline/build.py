@@ -53,8 +53,8 @@ from kinematics.errors import ConvergenceError, DesignError, MechanismError
 
 from cadgen.pipeline.progress import WRITE_STAGE
 
-__all__ = ["EFFECT_STAGES", "plan", "stage_warnings", "BuildResult", "build", "EXIT_OK",
-           "EXIT_CHECKS_FAILED", "run_analysis", "AnalysisResult"]
+__all__ = ["EFFECT_STAGES", "plan", "scene_plan", "stage_warnings", "BuildResult", "build",
+           "EXIT_OK", "EXIT_CHECKS_FAILED", "run_analysis", "AnalysisResult"]
 
 
 EXIT_OK = 0
@@ -442,10 +442,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     params, knobs = apply_preset(params, preset)
     effects = tuple(effects) if effects is not None else scene.effects
     case = case or scene.case
-    stages, set_aside = plan(effects, params.mechanism, case)
-    if not stages:
-        _nothing_to_build(set_aside)
-    warnings = stage_warnings(params, stages)
+    stages, set_aside, warnings = scene_plan(params, effects, case)
     run = _Build(params, stages, steps, progress)
     run.warnings = warnings
     run.effects, run.case, run.cache = effects, case, cache
@@ -460,6 +457,23 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         if output_root is None:
             return BuildResult(params.name, report, None)
         return _write(run, Path(output_root) / params.name)
+
+
+def scene_plan(params, effects, case: str = "field"):
+    """``(stages, set_aside, warnings)`` of a scene for a validated design: what
+    :func:`build` runs, the effects it sets aside with the reason, and the stage problems
+    it keeps as warnings.
+
+    Raises
+    ------
+    cadgen.params.ParameterError
+        What :func:`build` refuses before any stage runs: a problem of a stage the scene
+        runs (:func:`stage_warnings`), or no effect of the scene applying to the design.
+    """
+    stages, set_aside = plan(effects, params.mechanism, case)
+    if not stages:
+        _nothing_to_build(set_aside)
+    return stages, set_aside, stage_warnings(params, stages)
 
 
 def _nothing_to_build(set_aside: dict) -> None:

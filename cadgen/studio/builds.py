@@ -142,17 +142,18 @@ class BuildJobs:
         Raises
         ------
         cadgen.ParameterError
-            The design does not validate, or a problem of a stage its scene runs (the
-            duckbill linkage when the cam is built): what ``cadgen build`` refuses.
+            The design does not validate, a problem of a stage its scene runs (the
+            duckbill linkage when the cam is built), or no effect of its scene applies:
+            what ``cadgen build`` refuses.
         BuildBusy
             A build is running.
         """
         from cadgen import validate_data
-        from cadgen.pipeline.build import plan, stage_warnings
+        from cadgen.pipeline.build import scene_plan
 
         validated = validate_data(params)
         scene = validated.scene
-        stage_warnings(validated, plan(scene.effects, validated.mechanism, scene.case)[0])
+        scene_plan(validated, scene.effects, scene.case)
         with self._lock:
             running = [job for job in self._jobs.values() if job.running]
             if running:
