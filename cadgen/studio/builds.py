@@ -149,7 +149,7 @@ class BuildJobs:
             A build is running.
         """
         from cadgen import validate_data
-        from cadgen.pipeline.build import scene_plan
+        from cadgen.pipeline.plan import scene_plan
 
         validated = validate_data(params)
         scene = validated.scene

@@ -1,0 +1,129 @@
+"""Which stages a scene runs: the effects' stages and the stages' own needs, the effects that
+mean nothing for a design (set aside with the reason), and what a build refuses before any
+stage runs (:func:`scene_plan`).
+
+A scene (``[scene]`` in the file, or ``effects``/``case`` given to
+:func:`cadgen.pipeline.build.build`) names the effects wanted; :func:`plan` resolves the
+stages they need, in run order, and nothing else runs: a scene asking only for ``metrics``
+generates no teeth, builds no solids and never imports fcl.
+"""
+
+from __future__ import annotations
+
+__all__ = ["EFFECT_STAGES", "STAGE_NEEDS", "STAGE_ORDER", "NOT_APPLICABLE", "plan",
+           "scene_plan", "stage_warnings"]
+
+
+#: The stages each effect needs (their own needs are added by :func:`plan`).
+EFFECT_STAGES = {
+    "metrics": ("metrics",),
+    "curves": ("kinematics",),
+    "teeth": ("drivetrain", "teeth"),    # every gear bored for its shaft
+    "meshing": ("drivetrain", "teeth"),  # the meshing check is part of cutting (tip relief)
+    "cam": ("cam",),
+    "solids": ("cam", "parts"),       # gears among the solids when "teeth" runs too
+    "arm_interference": ("cam", "parts", "arm_interference"),
+    "ground_clearance": ("metrics", "parts", "ground_clearance"),
+    "dxf": (),                 # the cutting files of the teeth and cam that run (both if alone)
+    "stl": ("cam", "parts"),
+    # the trajectory, attitude and speed figures are drawn from the metrics' events (soil
+    # line, holes); the plots stage itself needs only the kinematics, so that the gears'
+    # figures are still drawn when the metrics fail
+    "plots": ("metrics", "plots"),
+    # the report's verdict is the metrics against the targets: asked alone it once ran no
+    # stage at all and said PASSED of nothing
+    "report": ("metrics",),
+}
+
+#: Each stage's own needs, and the order stages run in.
+STAGE_NEEDS = {
+    "kinematics": (),
+    "metrics": ("kinematics",),
+    "cam": ("metrics",),
+    "drivetrain": ("kinematics",),
+    "teeth": ("kinematics",),
+    "parts": ("metrics", "drivetrain"),
+    "arm_interference": ("parts",),
+    "ground_clearance": ("parts",),
+    "plots": ("kinematics",),
+}
+STAGE_ORDER = tuple(STAGE_NEEDS)
+
+#: Effects with no meaning for a mechanism kind or an operating case (reported, not run).
+NOT_APPLICABLE = {
+    ("pricking", "cam"): "the pricking mechanism has no cam",
+    ("pricking", "arm_interference"): "the pricking mechanism has a single arm",
+    ("bench", "ground_clearance"): "a bench run has no soil",
+}
+
+
+def plan(effects, mechanism: str = "planting", case: str = "field"):
+    """Stages to run for ``effects`` (in run order) and the effects set aside with the reason."""
+    wanted, set_aside = set(), {}
+    for effect in effects:
+        reason = NOT_APPLICABLE.get((mechanism, effect)) or NOT_APPLICABLE.get((case, effect))
+        if reason:
+            set_aside[effect] = reason
+            continue
+        wanted.update(EFFECT_STAGES[effect])
+    if "dxf" in effects and not {"teeth", "meshing", "cam", "solids", "stl"} & set(effects):
+        wanted.update(("teeth", "cam"))   # asked alone, DXF means every cutting file
+    if mechanism == "pricking":
+        wanted.discard("cam")
+        wanted.discard("arm_interference")
+    if case == "bench":
+        wanted.discard("ground_clearance")
+    closed = set()
+    stack = list(wanted)
+    while stack:
+        stage = stack.pop()
+        if stage not in closed:
+            closed.add(stage)
+            stack.extend(STAGE_NEEDS[stage])
+    return [s for s in STAGE_ORDER if s in closed], set_aside
+
+
+def scene_plan(params, effects, case: str = "field"):
+    """``(stages, set_aside, warnings)`` of a scene for a validated design: what
+    :func:`build` runs, the effects it sets aside with the reason, and the stage problems
+    it keeps as warnings.
+
+    Raises
+    ------
+    cadgen.params.ParameterError
+        What :func:`build` refuses before any stage runs: a problem of a stage the scene
+        runs (:func:`stage_warnings`), or no effect of the scene applying to the design.
+    """
+    stages, set_aside = plan(effects, params.mechanism, case)
+    if not stages:
+        _nothing_to_build(set_aside)
+    return stages, set_aside, stage_warnings(params, stages)
+
+
+def _nothing_to_build(set_aside: dict) -> None:
+    """Refuse a scene none of whose effects applies to the design (a cam asked of the pricking
+    mechanism): its build would run no stage and say PASSED of nothing."""
+    from cadgen.params import ParameterError
+    from kinematics.errors import Problem
+
+    reasons = "; ".join(f"{effect}: {reason}" for effect, reason in set_aside.items())
+    raise ParameterError([Problem("scene.effects", "nothing_to_build",
+                                  "no effect of the scene applies to this design"
+                                  + (f" ({reasons})" if reasons else ""))])
+
+
+def stage_warnings(params, stages) -> list:
+    """The stage problems of ``params`` whose stage is not in ``stages``, as warnings.
+
+    Raises
+    ------
+    cadgen.params.ParameterError
+        With the stage problems whose stage is in ``stages`` (the build cannot run it).
+    """
+    from cadgen.params import ParameterError, stage_problems
+
+    problems = stage_problems(params)
+    refused = [p for p in problems if p.stage in stages]
+    if refused:
+        raise ParameterError(refused)
+    return [p for p in problems if p.stage not in stages]
