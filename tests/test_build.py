@@ -176,6 +176,18 @@ def test_a_scene_none_of_whose_effects_applies_is_refused_and_writes_nothing(tmp
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("design", [REFERENCE, KERNEL_A], ids=["planting", "pricking"])
+def test_a_bench_runs_animation_has_no_soil_line(design, tmp_path):
+    # its report leaves out what needs soil; the animation drew the soil line all the same
+    pages = {}
+    for case in ("field", "bench"):
+        build(load_params(design), tmp_path / case, effects=["report"], case=case)
+        pages[case] = (tmp_path / case / design.stem / "report.html").read_text(encoding="utf-8")
+    assert "soil surface" in pages["field"]
+    assert "soil surface" not in pages["bench"]
+    assert '"soil": null' in pages["bench"] or '"soil":null' in pages["bench"]
+
+
 def test_a_report_asked_alone_holds_the_metrics_it_judges(tmp_path):
     # it once ran no stage, wrote a report of nothing and said PASSED
     result = build(load_params(REFERENCE), tmp_path, effects=["report"])

@@ -83,7 +83,8 @@ def animation_of(run) -> dict:
     if "_animation" not in run.__dict__:
         from cadgen.report.animation import animation_data
 
-        run.__dict__["_animation"] = animation_data(run.params, run.values)
+        run.__dict__["_animation"] = animation_data(
+            run.params, run.values, soil=getattr(run, "case", "field") != "bench")
     return run.__dict__["_animation"]
 
 

@@ -92,7 +92,8 @@ def _placed(local, origin, angle) -> np.ndarray:
 placed = _placed
 
 
-def planting_animation(params, mechanism, evaluation=None, poses: int = POSES) -> dict:
+def planting_animation(params, mechanism, evaluation=None, poses: int = POSES, *,
+                       soil: bool = True) -> dict:
     """The planting mechanism's animation data (see :func:`animation_section`).
 
     Parameters
@@ -102,6 +103,8 @@ def planting_animation(params, mechanism, evaluation=None, poses: int = POSES) -
     evaluation : kinematics.evaluation.PlantingEvaluation, optional
         Gives the soil line and the gearbox envelope circles; without it (a build
         whose metrics failed) the arms move without them.
+    soil : bool
+        False for a bench run (no soil): no soil line.
     """
     phi = np.linspace(0.0, 2 * np.pi, poses, endpoint=False)
     path_phi = np.linspace(0.0, 2 * np.pi, PATH_SAMPLES + 1)
@@ -137,20 +140,20 @@ def planting_animation(params, mechanism, evaluation=None, poses: int = POSES) -
               ("arm arm2", "arm 2"), ("trail arm1", "tip trail"), ("path arm1", "tip path")]
     if circles:
         legend.append(("housing gearbox2", "gearbox envelope circles"))
-    soil = None
-    events = getattr(evaluation, "events", None)
+    level = None
+    events = getattr(evaluation, "events", None) if soil else None
     if events is not None and events.soil_level is not None and math.isfinite(events.soil_level):
-        soil = round(-float(events.soil_level), 1)
+        level = round(-float(events.soil_level), 1)
         legend.append(("soil", "soil surface"))
         drawn.append(np.array([[0.0, events.soil_level]]))
     return {"kind": "planting", "poses": poses, "seconds": CYCLE_SECONDS,
             "angles": [round(float(a), 1) for a in np.degrees(phi)],
             "angle_label": "carrier angle from the catching position",
-            "view": _bounds(*drawn), "soil": soil, "static": static, "moving": moving,
+            "view": _bounds(*drawn), "soil": level, "static": static, "moving": moving,
             "trails": trails, "legend": legend}
 
 
-def pricking_animation(design, field=None, poses: int = POSES) -> dict:
+def pricking_animation(design, field=None, poses: int = POSES, *, soil: bool = True) -> dict:
     """The pricking mechanism's animation data (see :func:`animation_section`).
 
     Parameters
@@ -158,6 +161,8 @@ def pricking_animation(design, field=None, poses: int = POSES) -> dict:
     design : kinematics.pricking.PrickingDesign
     field : list of kinematics.pricking_field.InclinationResult, optional
         The first inclination gives the soil surface in the mechanism plane.
+    soil : bool
+        False for a bench run (no soil): no soil line.
     """
     from kinematics.pricking_field import needle_geometry
 
@@ -185,23 +190,23 @@ def pricking_animation(design, field=None, poses: int = POSES) -> dict:
     legend = [("carrier", "carrier O-A-B (gear case)"), ("rocker", "rocker (planet)"),
               ("needle", "needle"), ("trail arm1", "tip trail"), ("path arm1", "tip loop")]
     drawn = [loop, carrier, root]
-    soil = None
-    if field:
+    level = None
+    if field and soil:
         first = field[0]
-        soil = round(-float(first.surface_level), 1)
+        level = round(-float(first.surface_level), 1)
         legend.append(("soil", f"soil surface at {first.inclination_deg:g} deg inclination "
                                "(in the mechanism plane)"))
         drawn.append(np.array([[centre[0], first.surface_level]]))
     return {"kind": "pricking", "poses": poses, "seconds": CYCLE_SECONDS,
             "angles": [round(float(a), 1) for a in np.degrees(turn)],
             "angle_label": "carrier turn from the outer dead centre",
-            "view": _bounds(*drawn), "soil": soil,
+            "view": _bounds(*drawn), "soil": level,
             "static": [{"type": "polyline", "cls": "path arm1", "points": _xy(loop)}],
             "moving": moving, "trails": [{"cls": "trail arm1", "points": _xy(tip)}],
             "legend": legend}
 
 
-def animation_data(params, values: dict) -> dict | None:
+def animation_data(params, values: dict, *, soil: bool = True) -> dict | None:
     """The animation data of a build from its stages' values, or ``None`` without kinematics.
 
     Parameters
@@ -210,12 +215,14 @@ def animation_data(params, values: dict) -> dict | None:
     values : dict
         A build's ``run.values``: ``"kinematics"`` (required) and ``"metrics"``
         (optional: the soil line, the housings) when those stages ran.
+    soil : bool
+        False for a bench run: no soil line (its report leaves out what needs soil).
     """
     if "kinematics" not in values:
         return None
     if params.mechanism == "pricking":
-        return pricking_animation(values["kinematics"], values.get("metrics"))
-    return planting_animation(params, values["kinematics"], values.get("metrics"))
+        return pricking_animation(values["kinematics"], values.get("metrics"), soil=soil)
+    return planting_animation(params, values["kinematics"], values.get("metrics"), soil=soil)
 
 
 @functools.cache
