@@ -5,6 +5,8 @@ import subprocess
 import sys
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import cadgen.pipeline.build
 from cadgen.pipeline.build import build, plan
@@ -27,7 +29,7 @@ def params():
     (["curves"], ["kinematics"]),
     (["teeth"], ["kinematics", "drivetrain", "teeth"]),
     (["cam"], ["kinematics", "metrics", "cam"]),
-    (["dxf"], ["kinematics", "metrics", "cam", "teeth"]),
+    (["dxf"], ["kinematics", "metrics", "cam", "drivetrain", "teeth"]),
     (["arm_interference"], ["kinematics", "metrics", "cam", "drivetrain", "parts",
                             "arm_interference"]),
     (["ground_clearance"], ["kinematics", "metrics", "drivetrain", "parts", "ground_clearance"]),
@@ -36,6 +38,52 @@ def params():
 ])
 def test_each_effect_needs_exactly_its_stages(effects, stages):
     assert plan(effects)[0] == stages
+
+
+#: What the README's scene table promises each effect runs, besides the stages' own needs
+#: (README, "Scenes"): written here from the table, not from EFFECT_STAGES.
+PROMISED = {"metrics": {"metrics"}, "curves": {"kinematics"}, "teeth": {"teeth"},
+            "meshing": {"teeth"}, "cam": {"metrics", "cam"}, "solids": {"metrics", "parts"},
+            "stl": {"metrics", "parts"}, "arm_interference": {"parts", "arm_interference"},
+            "ground_clearance": {"metrics", "parts", "ground_clearance"}, "dxf": set(),
+            "plots": {"metrics", "plots"}, "report": {"metrics"}}
+NEEDS = {"metrics": {"kinematics"}, "cam": {"metrics"}, "drivetrain": {"kinematics"},
+         "teeth": {"kinematics", "drivetrain"}, "parts": {"metrics", "drivetrain"},
+         "arm_interference": {"parts"}, "ground_clearance": {"parts"}, "plots": {"kinematics"}}
+
+
+@settings(max_examples=300, deadline=None)
+@given(effects=st.lists(st.sampled_from(sorted(PROMISED)), unique=True, max_size=12),
+       mechanism=st.sampled_from(["planting", "pricking"]),
+       case=st.sampled_from(["field", "bench"]))
+def test_every_scene_runs_what_its_effects_promise_or_is_refused(effects, mechanism, case):
+    """Any set of effects, either mechanism, either case: each applicable effect gets the
+    stages the README promises it, the stages are closed under their needs and in run order,
+    nothing is set aside but what has no meaning, and a scene with nothing left is refused
+    (never a build of no stage that says PASSED)."""
+    from cadgen.params import ParameterError
+    from cadgen.pipeline.plan import STAGE_ORDER, _nothing_to_build
+
+    meaningless = {("pricking", "cam"), ("pricking", "arm_interference"),
+                   ("bench", "ground_clearance")}
+    applicable = [e for e in effects if (mechanism, e) not in meaningless
+                  and (case, e) not in meaningless]
+    stages, aside = plan(effects, mechanism, case)
+    assert set(aside) == set(effects) - set(applicable)
+    for effect in applicable:
+        promised = set(PROMISED[effect])
+        if mechanism == "pricking":
+            promised -= {"cam"}            # the pricking mechanism has none
+        assert promised <= set(stages), effect
+    if "dxf" in applicable and not {"teeth", "meshing", "cam", "solids", "stl"} & set(applicable):
+        assert "teeth" in stages and ("cam" in stages or mechanism == "pricking")
+    for stage in stages:
+        assert NEEDS.get(stage, set()) <= set(stages), stage
+    assert stages == sorted(stages, key=STAGE_ORDER.index)
+    assert bool(stages) == bool(applicable)
+    if not stages:
+        with pytest.raises(ParameterError):
+            _nothing_to_build(aside)
 
 
 def test_effects_without_meaning_are_set_aside_with_the_reason():
@@ -186,6 +234,16 @@ def test_a_bench_runs_animation_has_no_soil_line(design, tmp_path):
     assert "soil surface" in pages["field"]
     assert "soil surface" not in pages["bench"]
     assert '"soil": null' in pages["bench"] or '"soil":null' in pages["bench"]
+
+
+def test_dxf_asked_alone_writes_the_gears_as_the_teeth_effect_cuts_them(params, tmp_path):
+    # it once cut them without the drivetrain, so with other bores than every other scene's
+    alone = build(params, tmp_path / "alone", effects=["dxf"], cache=False)
+    with_teeth = build(params, tmp_path / "teeth", effects=["teeth", "dxf"], cache=False)
+    files = {p.name: p.read_bytes() for p in (alone.output_dir / "gears").iterdir()}
+    assert len(files) == 9 and "train.dxf" in files
+    assert files == {p.name: p.read_bytes() for p in (with_teeth.output_dir / "gears").iterdir()}
+    assert (alone.output_dir / "cam.dxf").is_file()
 
 
 def test_a_report_asked_alone_holds_the_metrics_it_judges(tmp_path):

@@ -59,15 +59,19 @@ NOT_APPLICABLE = {
 
 def plan(effects, mechanism: str = "planting", case: str = "field"):
     """Stages to run for ``effects`` (in run order) and the effects set aside with the reason."""
-    wanted, set_aside = set(), {}
+    wanted, set_aside, applicable = set(), {}, set()
     for effect in effects:
         reason = NOT_APPLICABLE.get((mechanism, effect)) or NOT_APPLICABLE.get((case, effect))
         if reason:
             set_aside[effect] = reason
             continue
+        applicable.add(effect)
         wanted.update(EFFECT_STAGES[effect])
-    if "dxf" in effects and not {"teeth", "meshing", "cam", "solids", "stl"} & set(effects):
-        wanted.update(("teeth", "cam"))   # asked alone, DXF means every cutting file
+    # alone among the effects that apply (a cam asked of the pricking mechanism is not there)
+    if "dxf" in applicable and not {"teeth", "meshing", "cam", "solids", "stl"} & applicable:
+        # asked alone, DXF means every cutting file, the gears bored for their shafts as the
+        # teeth effect cuts them (it once cut them without the drivetrain: other bores)
+        wanted.update((*EFFECT_STAGES["teeth"], *EFFECT_STAGES["cam"]))
     if mechanism == "pricking":
         wanted.discard("cam")
         wanted.discard("arm_interference")
