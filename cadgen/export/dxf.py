@@ -454,10 +454,27 @@ def _audited_bytes(doc, path: Path) -> bytes:
         messages = [f"error: {entry.message}" for entry in auditor.errors]
         messages += [f"fixed: {entry.message}" for entry in auditor.fixes]
         raise DxfExportError(f"{path}: the DXF document failed the ezdxf audit; nothing written", messages)
+    _classes_in_order(doc)
     stream = io.StringIO()
     with _fixed_metadata():
         doc.write(stream)
     return doc.encode(stream.getvalue())
+
+
+def _classes_in_order(doc) -> None:
+    """Register the document's CLASS records now, sorted by name, so that the file's bytes do
+    not depend on the process's string hashing.
+
+    ezdxf adds a CLASS for each entity type in use, iterating a set of type names, at write
+    time: the CLASSES section of the same drawing came out in one of two orders, run to run
+    (PYTHONHASHSEED). Their order means nothing in a DXF file (an object names its class);
+    the write adds none once they are all registered.
+    """
+    classes = doc.classes
+    classes.add_required_classes(doc.dxfversion)
+    ordered = sorted(classes.classes.items())
+    classes.classes.clear()
+    classes.classes.update(ordered)
 
 
 def _thin_gear(profile, outline: np.ndarray, pitch: np.ndarray, tolerance: float):

@@ -176,23 +176,38 @@ def _sheet_planes(placements, planes) -> tuple[list, list[str]]:
     return [int(plane) for plane in planes], problems
 
 
-def _label_anchor(gear: _PlacedGear, height: float) -> np.ndarray:
+def _label_anchor(gear: _PlacedGear, height: float, others=()) -> np.ndarray:
     """Inside the gear under its centre mark (or bore and keyway), else above it, where the label fits;
-    else below the gear."""
+    else outside the gear, below, above, left or right of it, the first place clear of
+    ``others`` (the outlines of the view's other gears, shapely polygons; a label once fell
+    below planet gear E into gear D, which meshes under it); below if none is."""
     import shapely
 
-    module = float(gear.profile.module)
+    name, module = gear.profile.name, float(gear.profile.module)
     clear = max(_hole_reach(gear.profile), CENTRE_MARK_HALF_LENGTH_MODULES * module) + module
     body = shapely.Polygon(gear.outline)
     for anchor in (gear.centre - [0.0, clear], gear.centre + [0.0, clear + TEXT_BOX_DEPTH * height]):
-        (x0, y0), (x1, y1) = _text_box(anchor, gear.profile.name, height)
+        (x0, y0), (x1, y1) = _text_box(anchor, name, height)
         if body.contains(shapely.box(x0, y0, x1, y1)):
             return anchor
-    return np.array([gear.centre[0], gear.outline[:, 1].min() - LABEL_GAP_MODULES * module])
+    gap, depth = LABEL_GAP_MODULES * module, TEXT_BOX_DEPTH * height
+    half = 0.5 * TEXT_WIDTH_PER_CHARACTER * len(name) * height
+    (x_low, y_low), (x_high, y_high) = gear.outline.min(axis=0), gear.outline.max(axis=0)
+    x, y = float(gear.centre[0]), float(gear.centre[1])
+    outside = [np.array(anchor) for anchor in ((x, y_low - gap), (x, y_high + gap + depth),
+                                                (x_low - gap - half, y + depth / 2),
+                                                (x_high + gap + half, y + depth / 2))]
+    for anchor in outside:
+        box = shapely.box(*_text_box(anchor, name, height).ravel())
+        if not any(other.intersects(box) for other in others):
+            return anchor
+    return outside[0]
 
 
 def _draw_views(msp, gears: list, label_height: float) -> None:
     """One view per plane, side by side along x, each titled, every shaft marked in each."""
+    import shapely
+
     title_height = TITLE_SCALE * label_height
     axes = []  # every shaft of the sheet once: (centre, centre-mark half length)
     for gear in gears:
@@ -202,7 +217,9 @@ def _draw_views(msp, gears: list, label_height: float) -> None:
     views = []
     for plane in planes:
         members = [gear for gear in gears if gear.plane == plane]
-        anchors = [_label_anchor(gear, label_height) for gear in members]
+        bodies = [shapely.Polygon(gear.outline) for gear in members]
+        anchors = [_label_anchor(gear, label_height, bodies[:k] + bodies[k + 1:])
+                   for k, gear in enumerate(members)]
         corners = [gear.outline for gear in members]
         corners += [_text_box(anchor, gear.profile.name, label_height)
                     for gear, anchor in zip(members, anchors)]
