@@ -631,3 +631,22 @@ def test_a_dxf_file_is_the_same_bytes_whatever_the_string_hashing():
                               text=True, check=True, env={**os.environ, "PYTHONHASHSEED": seed})
         digests.add(done.stdout)
     assert len(digests) == 1
+
+
+def test_every_label_of_a_pricking_train_sheet_is_clear_of_the_other_gears(tmp_path):
+    # kernel-b's "intermediate 2" fell below its gear into the planet, which meshes under it
+    from cadgen.params import load_params
+    from cadgen.pipeline.build import build
+    from tests.helpers import REFERENCE
+
+    result = build(load_params(REFERENCE.parent / "kernel-b.toml"), tmp_path, effects=["dxf"])
+    doc = ezdxf.readfile(result.output_dir / "gears" / "train.dxf")
+    outlines = [shapely.Polygon(e.get_points(format="xy"))
+                for e in _entities(doc, "OUTLINE", "LWPOLYLINE")]
+    labels = [t for t in _entities(doc, LABEL_LAYER, "TEXT")
+              if not t.dxf.text.startswith("gear plane")]
+    assert len(outlines) == len(labels) == 4
+    for label in labels:
+        box = shapely.box(*_text_box(label).ravel())
+        assert not any(outline.exterior.intersects(box) for outline in outlines), label.dxf.text
+        assert sum(outline.contains(box) for outline in outlines) <= 1, label.dxf.text
