@@ -132,3 +132,31 @@ def test_a_cutting_file_that_fails_ahead_is_said_by_the_writing_with_its_path(tm
     assert len(asked) == 2 and asked[1].endswith("/cam.dxf") and asked[1] != "cam.dxf"
     assert asked[1] in str(raised.value)                # the writing's own path, in the error
     assert not (tmp_path / params.name).exists()
+
+
+@pytest.mark.parametrize("name", ["xin2024-planter", "kernel-b"])
+def test_the_gearless_kinds_are_built_the_same_with_and_without_the_gears(name):
+    """What GEARLESS_KINDS claims, checked part by part: the worker's meshes of these kinds are
+    taken for the build's own. kernel-b's ground reaches past the largest gear disc, so it was
+    longer without the gears, and a build of solids without sweeps wrote that one."""
+    import numpy as np
+
+    import cadgen.pipeline.build as pipeline
+    from cadgen.pipeline.beside import gearless_kinds
+
+    params = load_params(ROOT / "params" / f"{name}.toml")
+    stages = ["kinematics", "metrics", "cam", "drivetrain", "teeth"]
+    run = pipeline._Build(params, [s for s in stages if not (s == "cam" and
+                                                              params.mechanism == "pricking")],
+                          None)
+    run.effects, run.case, run.cache = ["stl"], "field", False
+    run.run(pipeline.STAGE_FUNCTIONS)
+    assert all(r.status == "ok" for r in run.records)
+    kinds = gearless_kinds(params.mechanism)
+    made = {gears: {p.name: p for p in pipeline._parts(run, gears=gears).assembly.parts
+                    if p.kind in kinds} for gears in (True, False)}
+    assert made[True] and set(made[True]) == set(made[False])
+    for part_name, part in made[True].items():
+        other = made[False][part_name]
+        assert np.array_equal(part.mesh.vertices, other.mesh.vertices), part_name
+        assert np.array_equal(part.mesh.faces, other.mesh.faces), part_name

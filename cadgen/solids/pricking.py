@@ -39,8 +39,9 @@ __all__ = ["pricking_assembly", "GEARLESS_KINDS"]
 #: Part kinds built the same with or without the gears (see
 #: :data:`cadgen.solids.planting.GEARLESS_KINDS`). Not the gear case: it is drawn round the
 #: gears' own outlines (without them, round a coarser and larger envelope), so its sweep
-#: waits for the gears.
-GEARLESS_KINDS = frozenset({"rocker", "needle", "ground"})
+#: waits for the gears; nor the ground, whose length reaches past the largest of those
+#: discs (a build of solids without sweeps once took the gearless ground's mesh).
+GEARLESS_KINDS = frozenset({"rocker", "needle"})
 
 
 def _carrier_angle(design, angle):
