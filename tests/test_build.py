@@ -12,6 +12,7 @@ import cadgen.pipeline.build
 from cadgen.pipeline.build import build, plan
 from cadgen.cli import EXIT_CHECKS_FAILED, EXIT_OK, main
 from cadgen.params import load_params
+from cadgen.params.scene import EFFECTS
 from kinematics.errors import DesignError, Problem
 
 from helpers import REFERENCE, edited
@@ -266,6 +267,26 @@ def test_two_processes_write_the_same_bytes_whatever_their_string_hashing(tmp_pa
     assert any(name.endswith(".dxf") for name in trees[0])
     assert any(name.endswith(".stl") for name in trees[0])
     assert trees[0] == trees[1]
+
+
+@pytest.mark.parametrize("design", [REFERENCE, REFERENCE.parent / "kernel-b.toml"],
+                         ids=["planting", "pricking"])
+def test_a_file_is_the_same_bytes_whichever_scene_writes_it(design, tmp_path):
+    """A scene runs only what its effects need, and the files it writes are those of the full
+    build, byte for byte (scenes with the teeth: solids without them are gearless by design).
+    Found wrong: dxf alone cut the gears with other bores; a scene of solids without sweeps
+    wrote the pricking ground of the gearless assembly."""
+    params = load_params(design)
+    full = build(params, tmp_path / "full", effects=list(EFFECTS))
+    reference = {str(p.relative_to(full.output_dir)): p.read_bytes()
+                 for p in full.output_dir.rglob("*") if p.is_file()}
+    for effects in (["dxf"], ["teeth", "stl"], ["plots"]):
+        result = build(params, tmp_path / "-".join(effects), effects=effects)
+        written = {str(p.relative_to(result.output_dir)): p.read_bytes()
+                   for p in result.output_dir.rglob("*")
+                   if p.is_file() and p.name not in ("report.json", "report.html")}
+        assert written and set(written) <= set(reference), effects
+        assert {name for name in written if written[name] != reference[name]} == set(), effects
 
 
 def test_a_report_asked_alone_holds_the_metrics_it_judges(tmp_path):
