@@ -122,6 +122,14 @@ class _Build:
         self.figures: dict = {}
         self.writers: list = []
         self.warnings: list = []
+        self.effects: tuple = ()       # the scene's (set by :func:`build`)
+        self.case = "field"
+
+    @property
+    def soil(self) -> bool:
+        """Whether the run has soil: a bench run has none, and its figures, animation and
+        report leave out what needs it."""
+        return self.case != "bench"
 
     def status(self, stage: str) -> str:
         return next((r.status for r in self.records if r.stage == stage), "not run")
@@ -241,7 +249,7 @@ def _teeth(run):
                                 key_slot_allowance=fits.key_slot_allowance,
                                 segments=params.solids.segments_per_circle)
         train = dataclasses.replace(train, rims=rims)
-        if {"parts", "dxf"} & ({*run.stages} | {*getattr(run, "effects", ())}):
+        if {"parts", "dxf"} & ({*run.stages} | {*run.effects}):
             from cadgen.pipeline.gear_cache import remember_cutting_outlines
 
             remember_cutting_outlines(train, params.gears.chord_tolerance)

@@ -22,17 +22,17 @@ def figure_jobs(run) -> dict:
     ok = {r.stage for r in run.records if r.status == "ok"}
     values, params = run.values, run.params
     jobs = {}
-    soil = getattr(run, "case", "field") != "bench"   # a bench run's figures show no soil
     if params.mechanism == "pricking":
         if {"kinematics", "metrics"} <= ok:
             from cadgen.report.plots.pricking import pricking_figure_jobs
 
             jobs.update(pricking_figure_jobs(params, values["kinematics"], values["metrics"],
-                                             soil=soil))
+                                             soil=run.soil))
     elif "metrics" in ok:
         from cadgen.report.plots.planting import planting_figure_jobs
 
-        jobs.update(planting_figure_jobs(values["kinematics"], values["metrics"], soil=soil))
+        jobs.update(planting_figure_jobs(values["kinematics"], values["metrics"],
+                                          soil=run.soil))
     if "teeth" in ok and values["teeth"].stages:
         from cadgen.report.plots.parts import pair_figure_jobs
 

@@ -83,8 +83,7 @@ def animation_of(run) -> dict:
     if "_animation" not in run.__dict__:
         from cadgen.report.animation import animation_data
 
-        run.__dict__["_animation"] = animation_data(
-            run.params, run.values, soil=getattr(run, "case", "field") != "bench")
+        run.__dict__["_animation"] = animation_data(run.params, run.values, soil=run.soil)
     return run.__dict__["_animation"]
 
 
