@@ -191,7 +191,7 @@ def _label_anchor(gear: _PlacedGear, height: float, others=()) -> np.ndarray:
         if body.contains(shapely.box(x0, y0, x1, y1)):
             return anchor
     gap, depth = LABEL_GAP_MODULES * module, TEXT_BOX_DEPTH * height
-    half = 0.5 * TEXT_WIDTH_PER_CHARACTER * len(name) * height
+    half = float(_text_box((0.0, 0.0), name, height)[1, 0])   # the box the writer counts
     (x_low, y_low), (x_high, y_high) = gear.outline.min(axis=0), gear.outline.max(axis=0)
     x, y = float(gear.centre[0]), float(gear.centre[1])
     outside = [np.array(anchor) for anchor in ((x, y_low - gap), (x, y_high + gap + depth),
