@@ -18,7 +18,7 @@ Run:  python -m benchmarks.performance [--output docs/performance.md] [--quick]
    paper's assembly with the build's own scenes and bounds (blades included), each
    against a reference (the certified sweep at ``atol`` 1e-10 mm): time, ratio, error.
 3. **Accuracy presets**: the full build (gear cache cold) at ``--preset`` draft, standard
-   (the default) and fine, three runs each: what the README's preset table quotes.
+   (the default) and fine, three interleaved runs each: what the README's preset table quotes.
 4. **What each effect costs**: scenes from metrics only to every effect, each adding
    effects to the one before (gear cache cold, five interleaved runs).
 5. **Batch throughput**: ``cadgen batch`` over a grid of 4 variants of the paper's
@@ -165,18 +165,28 @@ def sweep_table() -> list:
     return rows
 
 
+def _cold_runs(commands: dict, runs: int) -> dict:
+    """``{key: (median wall s, spread, median CPU s)}`` of ``cadgen`` commands (``{key: args}``),
+    each run with the gear cache emptied first, interleaved: one run of each per round."""
+    walls = {key: [] for key in commands}
+    cpus = {key: [] for key in commands}
+    for _ in range(runs):
+        for key, args in commands.items():
+            _empty_cache()
+            walls[key].append(_cadgen(*args))
+            cpus[key].append(_CPU[-1])
+    return {key: (statistics.median(walls[key]), _spread(walls[key]),
+                  statistics.median(cpus[key])) for key in commands}
+
+
 def preset_table(root: Path, runs: int = 3) -> list:
     """``[(preset, median wall s, spread, median CPU s)]``: the full build, cache cold."""
-    rows = []
-    for preset in ("draft", "standard", "fine"):
-        walls, cpus = [], []
-        for _ in range(runs):
-            _empty_cache()
-            walls.append(_cadgen("build", str(PARAMS), "--preset", preset, "--output-dir",
-                                 str(root / f"preset-{preset}")))
-            cpus.append(_CPU[-1])
-        rows.append((preset, statistics.median(walls), _spread(walls), statistics.median(cpus)))
-        print(f"preset {preset}: {rows[-1][1]:.2f} s", flush=True)
+    presets = ("draft", "standard", "fine")
+    found = _cold_runs({preset: ("build", str(PARAMS), "--preset", preset, "--output-dir",
+                                 str(root / f"preset-{preset}")) for preset in presets}, runs)
+    rows = [(preset, *found[preset]) for preset in presets]
+    for preset, wall, _, _ in rows:
+        print(f"preset {preset}: {wall:.2f} s", flush=True)
     return rows
 
 
@@ -197,16 +207,9 @@ SCENES = (("metrics", "metrics"),
 def scene_table(root: Path, runs: int = 5) -> list:
     """``[(label, effects, median wall s, spread, median CPU s)]``: the scenes of
     :data:`SCENES`, gear cache cold, interleaved (one run of each scene per round)."""
-    walls = {effects: [] for _, effects in SCENES}
-    cpus = {effects: [] for _, effects in SCENES}
-    for _ in range(runs):
-        for _, effects in SCENES:
-            _empty_cache()
-            walls[effects].append(_cadgen("build", str(PARAMS), "--effects", effects,
-                                          "--output-dir", str(root / "scenes")))
-            cpus[effects].append(_CPU[-1])
-    rows = [(label, effects, statistics.median(walls[effects]), _spread(walls[effects]),
-             statistics.median(cpus[effects])) for label, effects in SCENES]
+    found = _cold_runs({effects: ("build", str(PARAMS), "--effects", effects, "--output-dir",
+                                  str(root / "scenes")) for _, effects in SCENES}, runs)
+    rows = [(label, effects, *found[effects]) for label, effects in SCENES]
     for label, _, wall, _, used in rows:
         print(f"scene {label}: {wall:.2f} s, CPU {used:.2f} s", flush=True)
     return rows
@@ -314,8 +317,8 @@ def main(argv=None):
     if presets:
         lines += ["", "## Accuracy presets", "",
                   "The full build of the paper's design, every effect, gear cache cold, at "
-                  "each `--preset` (three runs each, median; the knobs each sets are in the "
-                  "README and cadgen/params/scene.py).", "",
+                  "each `--preset` (three interleaved runs each, median; the knobs each sets "
+                  "are in the README and cadgen/params/scene.py).", "",
                   "| preset | median (s) | spread (s) | CPU (s) |", "|---|---:|---:|---:|"]
         lines += [f"| {preset} | {wall:.2f} | {spread} | {used:.2f} |"
                   for preset, wall, spread, used in presets]

@@ -28,7 +28,8 @@ def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius:
 
     ``contour`` (the working profile) on ``OUTLINE`` (the one closed cutting path), the bore
     on ``BORE``; ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and
-    a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as :func:`write_gear_dxf`.
+    a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as
+    :func:`cadgen.export.dxf.write_gear_dxf`.
     """
     path = Path(path)
     data, outline, used = _cam_file(path, contour, pitch_curve, bore_radius, chord_tolerance,

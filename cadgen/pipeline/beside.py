@@ -6,10 +6,10 @@ worker when the teeth stage begins. The worker inherits every value computed so 
 is pickled on the way in), builds and meshes the gearless parts (the assembly module's
 ``GEARLESS_KINDS``; whenever parts follow, even in a scene without sweeps or figures) and
 sends their meshes back at once, runs the FCL sweeps on them, then draws figures that show
-no gear; its results come back pickled (meshes, sweep records and values, PNG bytes). The building process cuts
-the teeth, builds the parts with the gears, takes the worker's meshes (drawing gear pairs'
-figures while they are not there yet) for the assembly view and the solids' files
-(:func:`plots_beside`), then shares the rest: the worker's gearless figures and
+no gear; its results come back pickled (meshes, sweep records and values, PNG bytes). The
+building process cuts the teeth, builds the parts with the gears, takes the worker's meshes
+(drawing gear pairs' figures while they are not there yet) for the assembly view and the
+solids' files (:func:`plots_beside`), then shares the rest: the worker's gearless figures and
 the gear pairs' are taken one at a time from counters both processes hold, whoever is free
 first, so neither waits on the other's last figures; then it collects the worker's results
 (:func:`collect`). What is computed is the same either way, file for file
@@ -151,7 +151,8 @@ def _beside_parts() -> dict:
                 run.records.append(record)
         _BESIDE["parts_record"] = record
         progress.finished("parts", record.status, record.seconds,
-                          detail=record.message or "the gearless ones, beside the teeth", beside=True)
+                          detail=record.message or "the gearless ones, beside the teeth",
+                          beside=True)
         return meshes
     except BaseException:
         _BESIDE["failed"] = True    # the next tasks compute nothing
