@@ -325,3 +325,32 @@ def test_a_bench_run_draws_no_soil(design, field_only, monkeypatch):
         for word in ("soil", "entry", "exit", "hole", "absolute", "s = "):
             assert word not in words, (name, word)
         assert_texts_clear(figure, name)
+
+
+def test_the_relative_path_draws_the_arms_one_loop_once(monkeypatch):
+    """Both arms' tips trace one loop (the model's arm 2 is arm 1 half a turn on): drawn for
+    each, arm 1's lay hidden under arm 2's, with a legend entry for a curve nobody could see."""
+    import numpy as np
+    from helpers import REFERENCE
+
+    from cadgen.design import build_mechanism
+    from cadgen.params import load_params
+
+    # what drawing it once rests on, checked on the model itself
+    mechanism = build_mechanism(load_params(REFERENCE))
+    phi = np.linspace(0.0, 2.0 * np.pi, 361)
+    np.testing.assert_allclose(mechanism.motion(phi, "N", 1).position,
+                               mechanism.motion(phi + np.pi, "N", 0).position, atol=1e-9)
+    file, stages, _ = DESIGNS["planting"]
+    figure = _build_figures(REFERENCE.parent / file, stages, monkeypatch)["relative_path.png"]
+    (axes,) = figure.axes
+    from matplotlib.text import Text
+
+    from cadgen.report.plots.legend import foot_legend_of
+
+    labels = [a.get_text() for a in foot_legend_of(figure).artists if isinstance(a, Text)]
+    assert [label for label in labels if label.startswith("tip N")] == [
+        "tip N, both arms (half a turn apart)"]
+    assert {"arm 1", "arm 2"} <= set(labels)
+    # one curve of the loop (hundreds of points), not two drawn on top of each other
+    assert len([line for line in axes.get_lines() if len(line.get_xdata()) > 100]) == 1

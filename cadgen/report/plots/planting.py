@@ -20,13 +20,17 @@ def _events_deg(evaluation, soil: bool = True):
 
 def relative_path(mechanism, evaluation, phi, soil: bool = True):
     figure, ax = _figure(5.5, 8.0)
+    # the model's arm 2 is arm 1 half a turn on (kinematics.planting): one loop, drawn once
+    # (drawn for each, arm 1's lay hidden under arm 2's with both in the legend)
+    tip = mechanism.motion(phi, "N").position
+    ax.plot(tip[:, 0], tip[:, 1], color="0.2", lw=1.2,
+            label="tip N, both arms (half a turn apart)")
     for arm, colour in ((0, "tab:blue"), (1, "tab:orange")):
-        tip = mechanism.motion(phi, "N", arm).position
-        ax.plot(tip[:, 0], tip[:, 1], color=colour, lw=1.2, label=f"tip N, arm {arm + 1}")
         pose = mechanism.positions(np.array([0.0]), arm=arm, points=("C", "E", "P1", "N"))
         line = np.vstack([pose[k][0] for k in ("C", "E", "P1", "N")])
         ax.plot([0.0, line[0, 0]], [0.0, line[0, 1]], color="0.5", lw=2)
-        ax.plot(line[:, 0], line[:, 1], "-o", color=colour, lw=2.2, ms=4, alpha=0.8)
+        ax.plot(line[:, 0], line[:, 1], "-o", color=colour, lw=2.2, ms=4, alpha=0.8,
+                label=f"arm {arm + 1}")
     for circle in evaluation.housing_circles:
         if circle.gearbox != "gearbox2":
             continue
