@@ -120,6 +120,12 @@ def test_bench_run_reports_only_what_needs_no_soil(params):
     keys = {m["key"] for m in result.report["metrics"]}
     assert keys == {"trajectory_height", "arm_distance", "module"}
     assert result.report["scene"]["case"] == "bench" and result.report["passed"]
+    # nor the search of a metric it leaves out (the housings over the soil surface)
+    field = build(params, None, effects=["metrics"])
+    searches = {case: set(report["accuracy"]["minimum_searches"])
+                for case, report in (("field", field.report), ("bench", result.report))}
+    assert "ground_clearance" in searches["field"]
+    assert searches["bench"] == searches["field"] - {"ground_clearance"}
 
 
 def test_a_failed_stage_is_reported_its_dependents_skipped_the_rest_written(

@@ -258,8 +258,9 @@ def test_png_writer_refuses_what_is_not_rgb():
 # The figures of real designs
 
 
-def _build_figures(path, stages, monkeypatch, case="field"):
-    """``{name: drawn figure}`` of a design built up to ``stages`` (the figures kept)."""
+def _build_figures(path, stages, monkeypatch, case="field", runs=None):
+    """``{name: drawn figure}`` of a design built up to ``stages`` (the figures kept; the run
+    appended to ``runs``)."""
     import cadgen.pipeline.build
     import cadgen.report.plots.base as base
     from cadgen.params import load_params
@@ -268,6 +269,8 @@ def _build_figures(path, stages, monkeypatch, case="field"):
     run = cadgen.pipeline.build._Build(load_params(path), stages, None)
     run.effects, run.case = ["plots"], case
     run.run(cadgen.pipeline.build.STAGE_FUNCTIONS)
+    if runs is not None:
+        runs.append(run)
     drawn = []
 
     def keep(figure):
@@ -354,3 +357,24 @@ def test_the_relative_path_draws_the_arms_one_loop_once(monkeypatch):
     assert {"arm 1", "arm 2"} <= set(labels)
     # one curve of the loop (hundreds of points), not two drawn on top of each other
     assert len([line for line in axes.get_lines() if len(line.get_xdata()) > 100]) == 1
+
+
+@pytest.mark.parametrize("design", list(DESIGNS), ids=list(DESIGNS))
+def test_a_bench_run_builds_no_ground_and_its_assembly_view_no_soil(design, monkeypatch):
+    """A bench has no soil: its solids had the soil slab all the same (written as
+    solids/ground.stl, drawn see-through in the 3D view) and its assembly view the soil line."""
+    from helpers import REFERENCE
+
+    file, stages, _ = DESIGNS[design]
+    stages = [*stages, "drivetrain", "parts"]
+    kinds, words = {}, {}
+    for case in ("field", "bench"):
+        runs = []
+        figures = _build_figures(REFERENCE.parent / file, stages, monkeypatch, case, runs)
+        (run,) = runs
+        assert run.status("parts") == "ok"
+        kinds[case] = {part.kind for part in run.values["parts"].assembly.parts}
+        words[case] = _words(figures["assembly.png"])
+    assert "ground" in kinds["field"] and "soil" in words["field"]    # so the checks can fail
+    assert kinds["bench"] == kinds["field"] - {"ground"}
+    assert "soil" not in words["bench"]

@@ -276,14 +276,15 @@ def _parts(run, gears: bool = True):
 
         assembly, housings = pricking_assembly(params, run.values["kinematics"], train,
                                                run.values["metrics"],
-                                               drivetrain=run.values["drivetrain"])
+                                               drivetrain=run.values["drivetrain"],
+                                               soil=run.soil)
         return solids_outcome(params, assembly, housings)
     from cadgen.solids.planting import planting_assembly
 
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
+    soil_level = run.values["metrics"].events.soil_level if run.soil else None  # bench: none
     assembly, housings, _ = planting_assembly(params, run.values["kinematics"], train, cam,
-                                              run.values["metrics"].events.soil_level,
-                                              drivetrain=run.values["drivetrain"])
+                                              soil_level, drivetrain=run.values["drivetrain"])
     return solids_outcome(params, assembly, {"gearbox1": housings[0], "gearbox2": housings[1]})
 
 

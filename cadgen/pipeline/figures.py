@@ -185,11 +185,11 @@ def _assembly(run) -> bytes:
         design, field = values["kinematics"], values["metrics"]
         loop = design.motion.tip(np.linspace(0, design.motion.period, 721))
         return assembly_view(outcome.assembly, angle, paths=[(loop, "needle-tip loop")],
-                             soil_level=field[0].surface_level,
+                             soil_level=field[0].surface_level if run.soil else None,
                              title=f"Solids {np.degrees(angle):g} deg of carrier turn after the "
                                    "outer dead centre (front view, in the mechanism plane)")
     mechanism = values["kinematics"]
     tip = mechanism.motion(np.linspace(0, 2 * np.pi, 721), "N").position
     return assembly_view(outcome.assembly, angle, paths=[(tip, "tip path N (relative)")],
-                         soil_level=values["metrics"].events.soil_level,
+                         soil_level=values["metrics"].events.soil_level if run.soil else None,
                          title=f"Solids at carrier angle {np.degrees(angle):g} deg (front view)")

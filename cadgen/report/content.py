@@ -110,8 +110,18 @@ def report_dict(params, mechanism, evaluation, case: str = "field") -> dict:
                     "pitch_perimeter_mm": evaluation.perimeter, "module_mm": evaluation.module,
                     "ratio_min": closure.ratio_min, "ratio_max": closure.ratio_max,
                     "arm_distance_at_deg": evaluation.arm_distance_at_deg},
-        "accuracy": evaluation.accuracy,
+        "accuracy": _without_soil(evaluation.accuracy),
     }
+
+
+def _without_soil(accuracy: dict) -> dict:
+    """The accuracy section of a bench run: the searches of metrics that need the soil (the
+    housings' clearance over the soil surface) left out with their metrics."""
+    searches = accuracy.get("minimum_searches")
+    if not isinstance(searches, dict):
+        return accuracy
+    return {**accuracy, "minimum_searches": {key: search for key, search in searches.items()
+                                             if key not in FIELD_METRICS}}
 
 
 #: Metrics that need the soil: not evaluated on a bench run.

@@ -57,7 +57,8 @@ def viewer_section(glb: bytes | None) -> str:
     return (
         '<section id="view-3d"><h2>3D view of the assembly</h2>'
         f'<p class="note">{html.escape("solids/assembly.glb")} ({size}), embedded: drag to turn, '
-        "scroll to zoom, right-drag to pan. Housing covers and soil are drawn see-through; "
+        "scroll to zoom, right-drag to pan. Housing covers, and the soil of a field run, are "
+        "drawn see-through; "
         "\u201cHide covers\u201d takes the covers off to show the gears and shafts. Drawn with "
         f"three.js {THREE_VERSION} (MIT), inlined: nothing is fetched.</p>"
         '<div class="viewer" id="cadgen-viewer" data-state="loading">'

@@ -370,10 +370,11 @@ def mechanism_extent(mechanism, circles, steps: int = 360) -> tuple:
     return float(xs.min() - reach), float(xs.max() + reach)
 
 
-def planting_assembly(params, mechanism, train, cam_design, soil_level: float, *,
+def planting_assembly(params, mechanism, train, cam_design, soil_level: float | None, *,
                       drivetrain=None) -> tuple:
     """Every solid of the planting mechanism and the poses of their bodies.
 
+    ``soil_level`` places the ground's surface; None (a bench run, no soil) makes no ground.
     ``drivetrain`` is the mechanism's :class:`~cadgen.machine.model.Drivetrain`
     (shafts, seats, housing stacks); None computes it
     (:func:`cadgen.machine.drivetrain.drivetrain`). Returns ``(assembly, housings,
@@ -405,8 +406,9 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float, *
     parts += _planter_parts(params, cam_design, layout, segments)
     x_range = mechanism_extent(mechanism, circles)
     z_range = layout.z_range
-    parts.append(ground_part(params.ground, soil_level, x_range, z_range,
-                             ridge_centre=layout.tube_axis, segments=segments))
+    if soil_level is not None:
+        parts.append(ground_part(params.ground, soil_level, x_range, z_range,
+                                 ridge_centre=layout.tube_axis, segments=segments))
     poses = body_poses(mechanism, layout)
 
     def pose(body, phi):

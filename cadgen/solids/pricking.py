@@ -59,11 +59,11 @@ def _pose_parameters(design, angle):
     return float(design.motion.invert(np.array([first]))[0]), phi1
 
 
-def pricking_assembly(params, design, train, field, *, drivetrain=None):
+def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bool = True):
     """Every solid of the pricking mechanism and the poses of their bodies.
 
     ``field`` is the list of :class:`~kinematics.pricking_field.InclinationResult`;
-    the ground uses the first. ``drivetrain`` is the design's
+    the ground uses the first (``soil`` False, a bench run: no ground). ``drivetrain`` is the design's
     :class:`~cadgen.machine.model.Drivetrain`; None computes it
     (:func:`cadgen.machine.drivetrain.drivetrain`). Returns ``(assembly,
     {"gear-case": SplitHousing})``.
@@ -170,6 +170,8 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None):
     parts += [shaft_part(shaft, case, "case", segments=segments, gears=frames)
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
     parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)
+    if not soil:
+        return Assembly(parts, body_pose), {"gear-case": case}
     surface = field[0].surface_level
     theta = math.radians(field[0].inclination_deg)
     reach = 2 * link.a + link.l + max(r for _, _, r in circles)
