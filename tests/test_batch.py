@@ -704,3 +704,33 @@ def test_progress_on_a_terminal_shows_running_and_queued_in_place():
     assert text.split("\r\x1b[K")[2] == "[0/4] 0% ok 0, failed 0, 2 running (r-001, -002), 2 queued"
     assert text.split("\r\x1b[K")[-1].startswith("[1/4] 25% ok 1, failed 0, 1 running (r-002), "
                                                  "2 queued, eta ")
+
+
+@pytest.mark.parametrize("workers, designs, build, told", [
+    (2, 4, None, False),                 # a design on every core: no worker beside each
+    (1, 4, None, None),                  # a core left: the build forks its worker beside
+    (2, 1, None, None),                  # one design: one worker, a core left
+    (2, 4, "own", None),                 # a build of the caller's may not take the keyword
+])
+def test_a_batch_keeps_each_build_to_its_process_when_every_core_has_a_design(
+        workers, designs, build, told, monkeypatch, tmp_path):
+    import cadgen.batch.run
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    seen = {}
+
+    def local(jobs, output_root, task, workers, on_result, on_start=None):
+        seen["kwargs"] = task[1]
+        return []
+
+    monkeypatch.setattr(cadgen.batch.run, "_run_local", local)
+    jobs = [cadgen.batch.DesignJob(f"d{i}", "grid.toml", data={}) for i in range(designs)]
+    run_batch(jobs, tmp_path, workers=workers, build=_own_build if build == "own" else build,
+              build_kwargs={"cache": False})
+    assert seen["kwargs"].get("parallel", None) is told
+    assert seen["kwargs"]["cache"] is False
+
+
+def _own_build(params, output_root, **kwargs):
+    """A build of a batch's caller (picklable by reference)."""
+    raise AssertionError("not run")

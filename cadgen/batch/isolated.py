@@ -25,7 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from cadgen.batch.grid import DesignJob
-from cadgen.batch.single import Build, _exception_failure, _resolve_build, _summary, run_design
+from cadgen.batch.single import (Build, _exception_failure, _is_default_build, _resolve_build,
+                                 _summary, run_design)
 
 __all__ = ["run_design_isolated"]
 
@@ -167,11 +168,23 @@ def _can_fork() -> bool:
             and not multiprocessing.current_process().daemon)
 
 
-def _warm(build: Build | None) -> None:
-    """Import the parameter schema and the build once here, not in every forked design."""
+def _warm(build: Build | None, job: DesignJob | None = None,
+          build_kwargs: Mapping | None = None) -> None:
+    """Import the parameter schema and the build once here, not in every forked design; for
+    the default build, what the design's scene imports too (:func:`cadgen.pipeline.warm.warm`,
+    done once: the next designs find them loaded)."""
     with contextlib.suppress(Exception):  # the design's process reports it
         importlib.import_module("cadgen.params")
         _resolve_build(build)
+        if not _is_default_build(build) or job is None or job.blocked_by:
+            return
+        from cadgen.params import load_params, validate_data
+        from cadgen.pipeline.warm import warm
+
+        params = (load_params(job.path) if job.path is not None
+                  else validate_data(job.data, job.source))
+        kwargs = build_kwargs or {}
+        warm(params, effects=kwargs.get("effects"), case=kwargs.get("case"))
 
 
 class _Child:
@@ -196,7 +209,7 @@ class _Child:
     def _fork(self, job, output_root, build, build_kwargs, lifeline):
         import multiprocessing
 
-        _warm(build)
+        _warm(build, job, build_kwargs)
         self.process = multiprocessing.get_context("fork").Process(
             target=_forked, name=f"cadgen-{job.name}", daemon=False,
             args=(job, output_root, build, build_kwargs, self.result, lifeline, self.job_end))

@@ -37,6 +37,11 @@ def _resolve_build(build: Build | None) -> Callable[..., Any]:
     return getattr(importlib.import_module(module), name)
 
 
+def _is_default_build(build: Build | None) -> bool:
+    """Whether ``build`` is :data:`DEFAULT_BUILD`, by name or as the function itself."""
+    return build is None or build == DEFAULT_BUILD or build is _resolve_build(DEFAULT_BUILD)
+
+
 def _snake(name: str) -> str:
     return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
 

@@ -74,7 +74,8 @@ def _shows_gears(figure: str) -> bool:
 
 def start_beside(run, functions):
     """Fork the worker beside the teeth (sweeps and gearless figures), or None: nothing for it
-    to do, no second core, no fork, or a failed stage before."""
+    to do, no second core, no fork, the build told not to (``parallel=False``), or a failed
+    stage before."""
     import multiprocessing
 
     from cadgen.pipeline.figures import _can_fork
@@ -87,7 +88,8 @@ def start_beside(run, functions):
     # the gearless parts are meshed there whenever parts follow: a scene of solids without
     # sweeps or figures once left the second core idle and took longer than one with them
     parts = "parts" in run.stages and bool(gearless_kinds(run.params.mechanism))
-    if not (sweeps or figures or parts) or "teeth" not in run.stages or not _can_fork() \
+    if not (sweeps or figures or parts) or "teeth" not in run.stages \
+            or run.parallel is False or not _can_fork() \
             or any(r.status != "ok" for r in run.records):
         return None
     from concurrent.futures import ProcessPoolExecutor

@@ -124,6 +124,7 @@ class _Build:
         self.warnings: list = []
         self.effects: tuple = ()       # the scene's (set by :func:`build`)
         self.case = "field"
+        self.parallel: bool | None = None   # False: no worker forked (see :func:`build`)
 
     @property
     def soil(self) -> bool:
@@ -305,7 +306,7 @@ def _ground_clearance(run):
 def _plots(run):
     from cadgen.pipeline.figures import build_figures
 
-    return build_figures(run)
+    return build_figures(run, parallel=False if run.parallel is False else None)
 
 
 STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "drivetrain": _drivetrain,
@@ -317,7 +318,8 @@ STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "drivetrain":
 # --------------------------------------------------------------------------- the build
 def build(params, output_root: Path | str | None = Path("outputs"), *, effects=None,
           case: str | None = None, steps: int | None = None,
-          preset: str | None = None, progress=None, cache=True) -> BuildResult:
+          preset: str | None = None, progress=None, cache=True,
+          parallel: bool | None = None) -> BuildResult:
     """Build one validated design: the stages its effects need, then its outputs.
 
     Parameters
@@ -345,6 +347,11 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         The gear cache (:mod:`cadgen.gears.cache`): True, the user's (see
         :func:`cadgen.pipeline.gear_cache.cache_directory`); a path, that directory; False or
         None, none (an unusable directory too). The report's ``gear_cache``: hits, misses.
+    parallel : bool or None, default None
+        None: a worker is forked beside the teeth where that helps (a second core, the fork
+        start method; :mod:`cadgen.pipeline.beside`). False: every stage in this process,
+        for a caller that already keeps every core busy (``cadgen batch``, a design per
+        core). The files are the same either way.
 
     Raises
     ------
@@ -372,7 +379,7 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     stages, set_aside, warnings = scene_plan(params, effects, case)
     run = _Build(params, stages, steps, progress)
     run.warnings = warnings
-    run.effects, run.case, run.cache = effects, case, cache
+    run.effects, run.case, run.cache, run.parallel = effects, case, cache, parallel
     run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
                                             for path, (value, source) in knobs.items()}}
     with _fewer_collections():
