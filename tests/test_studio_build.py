@@ -12,6 +12,7 @@ import json
 import os
 import re
 import signal
+import time
 import tomllib
 from pathlib import Path
 
@@ -124,10 +125,63 @@ def test_a_solids_build_links_its_assembly(tmp_path, example):
 
     done = collect(jobs, jobs.start(data))[-1]
 
+    jobs.shutdown()
     assert done["exit_code"] == reference.exit_code
     assert done["glb"] == f"/files/{example}/solids/assembly.glb"
     written = tmp_path / "studio" / example / "solids" / "assembly.glb"
     assert written.read_bytes() == (reference.output_dir / "solids" / "assembly.glb").read_bytes()
+
+
+def _wait_for(condition, seconds: float = 30.0) -> bool:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+def _loaded(pid: int, *libraries: str) -> bool:
+    """Whether the process has these extension modules mapped (Linux: /proc/PID/maps)."""
+    try:
+        maps = Path(f"/proc/{pid}/maps").read_text()
+    except OSError:
+        return False
+    return all(library in maps for library in libraries)
+
+
+@pytest.mark.skipif(not Path("/proc/self/maps").exists(), reason="reads /proc/PID/maps")
+def test_the_next_build_runs_in_a_child_made_ready_when_the_last_ended(tmp_path):
+    """A studio build paid a fresh interpreter's start and the build's imports (about half of
+    it): the next build's child is started once a build ends and imports them before its
+    design comes. It builds what a fresh child builds; one that died is not used; the waiting
+    child ends with the server."""
+    jobs = BuildJobs(tmp_path)
+    report = tmp_path / "xin2024-planter" / "report.json"
+    try:
+        first = collect(jobs, jobs.start(fast_params()))[-1]
+        metrics = json.loads(report.read_text())["metrics"]
+        assert _wait_for(lambda: jobs._spare is not None)
+        spare = jobs._spare[0]
+        # matplotlib's font renderer and fcl's bindings, loaded before any design came
+        assert _wait_for(lambda: _loaded(spare.pid, "ft2font", "fcl"))
+        job_id = jobs.start(fast_params())
+        assert jobs.get(job_id).pid == spare.pid
+        assert collect(jobs, job_id)[-1]["exit_code"] == first["exit_code"] == 0
+        assert json.loads(report.read_text())["metrics"] == metrics
+        # the next one dies waiting: the build after starts a child of its own
+        assert _wait_for(lambda: jobs._spare is not None)
+        dead = jobs._spare[0]
+        kill_group(dead.pid)
+        dead.wait()
+        job_id = jobs.start(fast_params())
+        assert jobs.get(job_id).pid != dead.pid
+        assert collect(jobs, job_id)[-1]["exit_code"] == 0
+        assert _wait_for(lambda: jobs._spare is not None)
+        last = jobs._spare[0]
+    finally:
+        jobs.shutdown()
+    assert last.returncode is not None and jobs._spare is None
 
 
 def test_a_late_subscriber_replays_every_event(studio_build):

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import importlib
 
-__all__ = ["STAGE_IMPORTS", "EFFECT_IMPORTS", "warm"]
+__all__ = ["STAGE_IMPORTS", "EFFECT_IMPORTS", "warm", "warm_all"]
 
 #: The modules each stage imports that take time (third-party packages and the modules of
 #: ours that load them); ``{mechanism}`` is the design's mechanism kind.
@@ -67,4 +67,22 @@ def warm(params, *, effects=None, case: str | None = None) -> list:
         from cadgen.pipeline.figures import preload
 
         preload()   # matplotlib's Agg figure and the figures' font
+    return names
+
+
+def warm_all() -> list:
+    """Import what any build may (every stage's and effect's modules, both mechanisms): for
+    a process made ready before its design is known (the studio's next build). Returns the
+    modules' names."""
+    from cadgen.params.loading import MECHANISM_KINDS
+
+    names = [name.format(mechanism=mechanism)
+             for group in (*STAGE_IMPORTS.values(), *EFFECT_IMPORTS.values())
+             for name in group for mechanism in MECHANISM_KINDS]
+    names = list(dict.fromkeys(names))
+    for name in names:
+        importlib.import_module(name)
+    from cadgen.pipeline.figures import preload
+
+    preload()
     return names
