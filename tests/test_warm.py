@@ -74,6 +74,7 @@ def test_warming_takes_the_designs_mechanism_and_scene():
     assert {"cadgen.solids.pricking", "cadgen.report.plots.pricking", "trimesh",
             "fcl"} <= set(pricking)
     assert not any(name.endswith(".planting") for name in pricking)
-    # a metrics-only scene imports none of the solids' or figures' libraries
-    assert warm(load_params(REFERENCE), effects=["metrics"]) == [
-        "cadgen.pipeline.writers", "cadgen.report.content"]
+    # a metrics-only scene imports no third-party library at all (as its build: README,
+    # "A metrics-only scene never ... imports fcl, manifold3d, trimesh or matplotlib")
+    metrics = warm(load_params(REFERENCE), effects=["metrics"])
+    assert metrics and {name.split(".")[0] for name in metrics} == {"cadgen"}

@@ -6,7 +6,7 @@ stages need them, so every forked design paid them again: about a third of a sec
 per design of the paper's. :func:`warm` imports what a design's scene will (its stages and
 effects, :func:`cadgen.pipeline.plan.scene_plan`) in the forking process, once; each build
 forked after it finds them loaded. Imports only: a build forked after :func:`warm` computes
-what one in a fresh interpreter does (the same files, tests/test_warm.py).
+what one in a fresh interpreter does.
 
 What each stage imports is listed here, beside the stage names; tests/test_warm.py checks
 that a build forked after warming for its scene loads no further third-party package, so the
@@ -60,14 +60,7 @@ def warm(params, *, effects=None, case: str | None = None) -> list:
              for group in ([STAGE_IMPORTS.get(stage, ()) for stage in stages]
                            + [EFFECT_IMPORTS.get(effect, ()) for effect in (None, *effects)])
              for name in group]
-    names = list(dict.fromkeys(names))
-    for name in names:
-        importlib.import_module(name)
-    if "plots" in stages:
-        from cadgen.pipeline.figures import preload
-
-        preload()   # matplotlib's Agg figure and the figures' font
-    return names
+    return _imported(names, figures="plots" in stages)
 
 
 def warm_all() -> list:
@@ -79,10 +72,16 @@ def warm_all() -> list:
     names = [name.format(mechanism=mechanism)
              for group in (*STAGE_IMPORTS.values(), *EFFECT_IMPORTS.values())
              for name in group for mechanism in MECHANISM_KINDS]
+    return _imported(names, figures=True)
+
+
+def _imported(names, *, figures: bool) -> list:
+    """Import ``names`` (each once, in order) and, for ``figures``, what drawing needs."""
     names = list(dict.fromkeys(names))
     for name in names:
         importlib.import_module(name)
-    from cadgen.pipeline.figures import preload
+    if figures:
+        from cadgen.pipeline.figures import preload
 
-    preload()
+        preload()   # matplotlib's Agg figure and the figures' font
     return names

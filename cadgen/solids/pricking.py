@@ -63,14 +63,13 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     """Every solid of the pricking mechanism and the poses of their bodies.
 
     ``field`` is the list of :class:`~kinematics.pricking_field.InclinationResult`;
-    the ground uses the first (``soil`` False, a bench run: no ground). ``drivetrain`` is the design's
-    :class:`~cadgen.machine.model.Drivetrain`; None computes it
+    the ground uses the first (``soil`` False, a bench run: no ground). ``drivetrain`` is
+    the design's :class:`~cadgen.machine.model.Drivetrain`; None computes it
     (:func:`cadgen.machine.drivetrain.drivetrain`). Returns ``(assembly,
     {"gear-case": SplitHousing})``.
     """
     from kinematics.pricking_field import needle_geometry
 
-    from cadgen.solids.ground import ground_part
     from cadgen.solids.housings import ShellSize
     from dataclasses import replace
 
@@ -170,23 +169,27 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     parts += [shaft_part(shaft, case, "case", segments=segments, gears=frames)
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
     parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)
-    if not soil:
-        return Assembly(parts, body_pose), {"gear-case": case}
-    surface = field[0].surface_level
-    theta = math.radians(field[0].inclination_deg)
-    reach = 2 * link.a + link.l + max(r for _, _, r in circles)
-    x_range = (float(centre[0] - reach), float(centre[0] + reach))
-    ground = ground_part(params.ground, surface * math.cos(theta), x_range,
-                         (-floor, height + roof + wall + gap + 2 * params.linkage.needle_diameter),
-                         ridge_centre=0.0, segments=segments)
+    if soil:
+        reach = 2 * link.a + link.l + max(r for _, _, r in circles)
+        parts.append(_inclined_ground(
+            params, field[0], (float(centre[0] - reach), float(centre[0] + reach)),
+            (-floor, height + roof + wall + gap + 2 * params.linkage.needle_diameter), segments))
+    return Assembly(parts, body_pose), {"gear-case": case}
+
+
+def _inclined_ground(params, inclination, x_range, z_range, segments):
+    """The soil slab of the first inclination, tilted into the mechanism's frame."""
+    from cadgen.solids.ground import ground_part
+
+    theta = math.radians(inclination.inclination_deg)
+    ground = ground_part(params.ground, inclination.surface_level * math.cos(theta), x_range,
+                         z_range, ridge_centre=0.0, segments=segments)
     tilt = np.eye(4)
     c, s = math.cos(theta), math.sin(theta)
     # vertical-frame (X, Y, Z) -> mechanism frame: y = Y cos + Z sin, z = -Y sin + Z cos
     tilt[1:3, 1:3] = [[c, s], [-s, c]]
     ground.local = lambda angle, tilt=tilt: tilt
-    parts.append(ground)
-    return Assembly(parts, body_pose), {"gear-case": case}
-
+    return ground
 
 
 def _rocker_and_needle(params, link, needle, *, z0, segments):
