@@ -56,6 +56,10 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--out", type=Path, default=None)
     args = parser.parse_args(argv)
+    if not args.design.is_file():
+        parser.error(f"design: no file {args.design}")
+    if args.count < 1 or not 0 < args.spread < 1:
+        parser.error("--count must be at least 1 and --spread between 0 and 1 (exclusive)")
     out = args.out or Path(tempfile.mkdtemp(prefix="cadgen-perturbed-"))
     out.mkdir(parents=True, exist_ok=True)
     rng = random.Random(args.seed)

@@ -160,3 +160,9 @@ def test_the_gearless_kinds_are_built_the_same_with_and_without_the_gears(name):
         other = made[False][part_name]
         assert np.array_equal(part.mesh.vertices, other.mesh.vertices), part_name
         assert np.array_equal(part.mesh.faces, other.mesh.faces), part_name
+
+
+def test_parallel_takes_only_a_flag(tmp_path):
+    with pytest.raises(TypeError, match="parallel must be True, False or None, not 'no'"):
+        build(load_params(EXAMPLES[0]), tmp_path, effects=["metrics"], parallel="no")
+    assert not any(tmp_path.iterdir())

@@ -355,6 +355,8 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
 
     Raises
     ------
+    TypeError
+        Before anything runs, a ``parallel`` that is not True, False or None.
     cadgen.export.atomic.OutputDirError
         Before any stage runs, when ``output_root`` cannot take the outputs (a file, a
         read-only or virtual filesystem, an existing ``<output_root>/<name>`` file).
@@ -366,6 +368,8 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
     """
     from cadgen.params.scene import apply_preset
 
+    if parallel is not None and not isinstance(parallel, bool):
+        raise TypeError(f"parallel must be True, False or None, not {parallel!r}")
     if output_root is not None:
         from cadgen.export.atomic import check_output_root
 
