@@ -33,6 +33,7 @@ from pathlib import Path
 # the one-line report and crash file of a bug, shared with the studio's server and builds
 from cadgen.crash import CRASH_DIR_VARIABLE, one_line as _one_line
 from cadgen.crash import write_crash_file as _write_crash_file
+from cadgen.processes import Interrupts as _Interrupts
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_CHECKS_FAILED", "EXIT_PROBLEMS",
            "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE", "CRASH_DIR_VARIABLE"]
@@ -434,57 +435,6 @@ def _check_output_dir(args: argparse.Namespace) -> None:
         check_output_root(directory)
 
 
-class _Interrupts:
-    """While a command runs: Ctrl-C becomes one line and :data:`EXIT_INTERRUPTED`.
-
-    Installs a SIGINT handler (on the main thread, unless SIGINT is ignored, as in a
-    background job) that raises KeyboardInterrupt in this process and remembers it, so
-    an error that follows from the interrupt (a worker pool broken by it) is reported
-    as the interrupt. A worker forked from this process (the build's sweeps and figures)
-    inherits the handler and ends quietly instead: the terminal sends SIGINT to the whole
-    process group, and this process reports it once. A KeyboardInterrupt that Python
-    cannot raise (it landed in a finaliser) is not printed; it is still remembered.
-    """
-
-    def __init__(self):
-        self.owner = os.getpid()
-        self.seen = False
-        self.stopping = False
-        self._previous = None
-
-    def _handle(self, signum, frame):
-        if os.getpid() != self.owner:
-            os._exit(EXIT_INTERRUPTED)
-        self.seen = True
-        if not self.stopping:
-            raise KeyboardInterrupt
-
-    def _unraisable(self, unraisable):
-        if issubclass(unraisable.exc_type, KeyboardInterrupt):
-            self.seen = True
-            return
-        self._previous_hook(unraisable)
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        if (threading.current_thread() is threading.main_thread()
-                and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN):
-            self._previous = signal.signal(signal.SIGINT, self._handle)
-        self._previous_hook = sys.unraisablehook
-        sys.unraisablehook = self._unraisable
-        return self
-
-    def __exit__(self, *exc_info):
-        import signal
-
-        sys.unraisablehook = self._previous_hook
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
-        return False
-
-
 def entry() -> None:
     """The ``cadgen`` script and ``python -m cadgen``: :func:`main`, then a quick exit.
 
@@ -534,11 +484,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     one_thread_for_commands()   # before numpy loads (see cadgen.math_threads)
     with _Interrupts() as interrupts:
         try:
-            args = build_parser(argv).parse_args(argv)
-            _check_output_dir(args)
-            status = args.handler(args)
+            try:
+                args = build_parser(argv).parse_args(argv)
+                _check_output_dir(args)
+                status = args.handler(args)
+            finally:
+                # from here on an interrupt is not raised again (cadgen.processes.interrupts);
+                # one raised before this line lands in the except clause below
+                interrupts.stopping = True
         except KeyboardInterrupt:
-            interrupts.stopping = True
+            interrupts.seen = True
         except BrokenPipeError:
             # the reader went away (``cadgen build ... | head``): nothing to say, and
             # nowhere to say it; stdout to /dev/null so the interpreter's flush is quiet
@@ -548,16 +503,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                 pass
             return EXIT_BROKEN_PIPE
         except Exception as error:
-            interrupts.stopping = True
-            if not interrupts.seen:
+            if not interrupts.seen:     # (an error that follows from the interrupt is it)
                 from cadgen import OutputDirError
 
                 if isinstance(error, OutputDirError):
                     print(f"cadgen: {error}", file=sys.stderr)
                     return EXIT_PROBLEMS
                 return _internal_error(error, argv)
-        if interrupts.seen or interrupts.stopping:
-            interrupts.stopping = True
+        if interrupts.seen:
             print("cadgen: interrupted", file=sys.stderr)
             return EXIT_INTERRUPTED
         return status

@@ -22,6 +22,7 @@ ALLOWED = {
     "kinematics": set(),
     "cadgen.crash": {"cadgen"},      # a bug's one line and crash file (cli, studio)
     "cadgen.math_threads": set(),    # one math thread for the commands and the studio
+    "cadgen.processes": set(),       # interrupts and child processes (standard library only)
     "cadgen.geometry": set(),
     # loading calls the design checks, inside a function (see cadgen.params.feasibility)
     "cadgen.params": {"kinematics", "cadgen.params.feasibility"},
@@ -41,12 +42,13 @@ ALLOWED = {
     "cadgen.pipeline": {"kinematics", "cadgen.params", "cadgen.params.feasibility",
                         "cadgen.geometry", "cadgen.gears", "cadgen.cam", "cadgen.machine",
                         "cadgen.solids", "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report"},
-    "cadgen.batch": {"kinematics", "cadgen.params", "cadgen.export", "cadgen.pipeline"},
+    "cadgen.batch": {"kinematics", "cadgen.params", "cadgen.export", "cadgen.pipeline",
+                     "cadgen.processes"},
     # the studio: over the public API, the parameter models (its form's schema, its saves),
     # the evaluation's sections as report.json holds them, and the build's stage plan
     "cadgen.studio": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.cam",
                       "cadgen.solids", "cadgen.report", "cadgen.export", "cadgen.pipeline",
-                      "cadgen.crash", "cadgen.math_threads"},
+                      "cadgen.crash", "cadgen.math_threads", "cadgen.processes"},
     # the optimiser: the planting screen (kinematics.population), the exact path (design,
     # report's sections), the build's own checks (cam, machine, solids' housing rules, gears'
     # circular sizing), and the studio's parameter schema and comment-keeping writer (one
@@ -55,7 +57,7 @@ ALLOWED = {
                         "cadgen.cam", "cadgen.machine", "cadgen.solids", "cadgen.report",
                         "cadgen.export", "cadgen.studio"},
     # the command line uses the public API only (and the two helpers it shares with the studio)
-    "cadgen.cli": {"cadgen", "cadgen.crash", "cadgen.math_threads"},
+    "cadgen.cli": {"cadgen", "cadgen.crash", "cadgen.math_threads", "cadgen.processes"},
     "cadgen.__main__": {"cadgen.cli"},
     "cadgen": set(),                 # the API imports lazily, by name (see its _EXPORTS)
 }

@@ -12,12 +12,8 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
-import re
-import signal
 import subprocess
 import sys
-import time
 import tomllib
 from pathlib import Path
 
@@ -134,19 +130,6 @@ def test_batch_every_grid(grid, tmp_path):
     assert f"{count} designs in " in result.stdout
 
 
-def _interrupt(args, delay: float, cwd: Path):
-    """Start the real script in its own process group, SIGINT the group after ``delay`` s
-    (as Ctrl-C does to a terminal's foreground job); (exit code, stderr, seconds after
-    the signal)."""
-    process = subprocess.Popen([str(CADGEN), *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, start_new_session=True)
-    time.sleep(delay)
-    signalled = time.perf_counter()
-    os.killpg(process.pid, signal.SIGINT)
-    _, stderr = process.communicate(timeout=TIMEOUT)
-    return process.returncode, stderr, time.perf_counter() - signalled
-
-
 @pytest.mark.parametrize("file", GRIDS + STUDIES, ids=[p.stem for p in GRIDS + STUDIES])
 def test_build_on_a_grid_or_study_file_names_the_command_that_reads_it(file, tmp_path):
     # a user pointing `cadgen build` at the wrong kind of bundled file is told which command
@@ -205,32 +188,3 @@ def test_optimize_every_study(study, tmp_path):
     assert check.returncode == 0, check.stdout + check.stderr
 
 
-@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX)")
-def test_ctrl_c_during_a_build_leaves_nothing(tmp_path):
-    out = tmp_path / "out"
-    # 1.5 s in: the teeth are being cut while a forked worker runs the FCL sweeps
-    code, stderr, _ = _interrupt(["build", ROOT / "params" / "xin2024-planter.toml",
-                                  "--output-dir", out], 1.5, tmp_path)
-    assert code == 130, stderr
-    # the progress lines (stderr is a pipe: plain lines, "[elapsed s] stage: ...") come from
-    # this process alone, then the one line; the forked workers print nothing
-    lines = stderr.splitlines()
-    assert lines[-1] == "cadgen: interrupted", stderr
-    assert all(re.fullmatch(r"\[ *\d+\.\d s\] [a-z_]+( \(beside\))?: .+", line)
-               for line in lines[:-1]), stderr
-    assert not out.exists() or list(out.iterdir()) == []
-
-
-@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX)")
-def test_ctrl_c_stops_a_batch_promptly(tmp_path):
-    out = tmp_path / "out"
-    code, stderr, after = _interrupt(["batch", "--grid", GRIDS[0], "--output-dir", out,
-                                      "--workers", "2"], 2.0, tmp_path)
-    assert code == 130, stderr
-    lines = [line for line in stderr.splitlines() if not line.startswith("[")]  # progress
-    assert lines == ["cadgen: interrupted"]
-    assert after < 5.0          # the queued designs are not built after the interrupt
-    left = sorted(p.name for p in out.iterdir()) if out.exists() else []
-    assert not [n for n in left if n.startswith(".")], left
-    for name in left:           # a design already built is whole
-        assert (out / name / "report.json").is_file()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import pickle
@@ -14,46 +15,54 @@ from cadgen.batch.isolated import _clean_staging, run_design_isolated
 from cadgen.batch.single import (DEFAULT_BUILD, Build, _exception_failure, _is_default_build,
                                  _summary, run_design)
 from cadgen.batch.summary import _order
+from cadgen.processes import sigint_deferred
 
 __all__ = ["run_batch"]
 
 
-#: A local worker's state for Ctrl-C (see :func:`_worker_start`), and the queue on which it
-#: says which design it starts (read by the batch's process, see :func:`_run_local`).
-_WORKER = {"pid": None, "busy": False, "interrupted": False, "starts": None}
+#: A local worker's state (see :func:`_worker_start`): its interrupt handler, whether it runs a
+#: design, and the queue on which it says which design it starts (read by the batch's
+#: process, see :func:`_run_local`).
+_WORKER = {"interrupts": None, "busy": False, "starts": None}
 #: Seconds between looks at the local workers' starts while waiting for results.
 _START_POLL_SECONDS = 0.1
+#: What a worker tells on the starts queue, instead of a design's number, once its handler
+#: is in place: before that it holds no design and may be killed outright (_stop_workers).
+_READY = -1
 
 
 def _worker_start(starts=None) -> None:
     """Initializer of a local worker: Ctrl-C stops its design, cleanly, without a traceback.
 
-    The terminal sends SIGINT to the whole process group, the workers included. A busy
-    worker raises KeyboardInterrupt in its job (which kills its design's process group
-    and removes its staging folder, see :func:`run_design_isolated`); an idle one only
-    remembers it and starts no further design (a design already queued to it is
-    refused); a process forked from the worker ends quietly. The batch's own process
-    reports the interrupt once.
+    The terminal sends SIGINT to the whole process group, the workers included, and the
+    batch's process passes an interrupt on to its workers (one sent to it alone stops
+    them too). A busy worker raises KeyboardInterrupt in its job (which kills its
+    design's process group and removes its staging folder, see
+    :func:`run_design_isolated`), raised again if a library swallowed it
+    (:class:`cadgen.processes.Interrupts`); an idle one only remembers it and starts no
+    further design (a design already queued to it is refused); a process forked from
+    the worker ends quietly. The batch's own process reports the interrupt once. The
+    worker was started with SIGINT blocked (:func:`cadgen.processes.sigint_deferred`): a
+    Ctrl-C that came while it was still importing waits for this handler, and is handled
+    as soon as it is unblocked here.
     """
-    import signal
+    from cadgen.processes import Interrupts, release_deferred_sigint
 
-    _WORKER["pid"] = os.getpid()
     _WORKER["starts"] = starts
-    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
-        signal.signal(signal.SIGINT, _worker_interrupt)
+    _WORKER["interrupts"] = Interrupts(active=lambda: _WORKER["busy"]).install()
+    release_deferred_sigint()
+    if starts is not None:   # (after the release: an interrupt that came is taken by now)
+        starts.put((os.getpid(), _READY))
 
 
-def _worker_interrupt(signum, frame) -> None:
-    if _WORKER["pid"] != os.getpid():
-        os._exit(130)
-    _WORKER["interrupted"] = True
-    if _WORKER["busy"]:
-        raise KeyboardInterrupt
+def _interrupted() -> bool:
+    interrupts = _WORKER["interrupts"]
+    return interrupts is not None and interrupts.seen
 
 
 def _run_job(job, output_root, build, build_kwargs, timeout, isolate, number=None) -> dict:
     """What a worker runs for one design (the ``number``-th submitted, told on starting)."""
-    if _WORKER["interrupted"]:
+    if _interrupted():
         raise KeyboardInterrupt(f"interrupted before {job.name} started")
     _WORKER["busy"] = True
     if _WORKER["starts"] is not None and number is not None:
@@ -86,9 +95,10 @@ def _collect(futures: Mapping, finished: Iterable, on_result) -> list[dict]:
     return summaries
 
 
-def _completed(futures, submitted, starts, on_start):
-    """``futures`` as they complete; meanwhile ``on_start(name)`` for each design a worker
-    starts (told on ``starts`` as ``(worker pid, number submitted)``).
+def _completed(futures, submitted, starts, on_start, ready: set):
+    """``futures`` as they complete; meanwhile ``on_start(name)`` (if given) for each design
+    a worker starts (told on ``starts`` as ``(worker pid, number submitted)``), and the pid
+    of each worker that tells it is ready added to ``ready``.
 
     In the order things happened: a design's start before its result, and the result of
     the design a worker ran before the start of its next (a worker tells a start only
@@ -103,6 +113,9 @@ def _completed(futures, submitted, starts, on_start):
         done, pending = wait(pending, timeout=_START_POLL_SECONDS, return_when=FIRST_COMPLETED)
         while not starts.empty():
             pid, number = starts.get()
+            if number == _READY:
+                ready.add(pid)
+                continue
             previous = running.get(pid)
             if previous is not None and previous not in told:
                 wait([previous])
@@ -111,7 +124,8 @@ def _completed(futures, submitted, starts, on_start):
                 told.add(previous)
                 yield previous
             running[pid] = submitted[number]
-            on_start(futures[submitted[number]].name)
+            if on_start is not None:
+                on_start(futures[submitted[number]].name)
         for future in done:
             told.add(future)
             yield future
@@ -119,32 +133,84 @@ def _completed(futures, submitted, starts, on_start):
 
 def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import ProcessPoolExecutor
 
     # spawn: one start method on every platform, safe when the parent holds threads (a
     # Dask client); each worker pays its imports once and forks each design from there.
     context = multiprocessing.get_context("spawn")
-    starts = context.SimpleQueue() if on_start is not None else None
-    pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))), mp_context=context,
-                               initializer=_worker_start, initargs=(starts,))
-    futures, submitted = {}, []
+    if os.name == "posix":
+        from multiprocessing import resource_tracker
+
+        # started first: starting it unblocks SIGINT in this thread (its own guard), which
+        # would end the block below as soon as the pool made its first semaphore
+        resource_tracker.ensure_running()
+    pool, futures, submitted, ready = None, {}, [], set()
     try:
-        for number, job in enumerate(jobs):
-            submitted.append(pool.submit(_run_job, job, output_root, *task, number=number))
-            futures[submitted[-1]] = job
-        finished = (as_completed(futures) if starts is None
-                    else _completed(futures, submitted, starts, on_start))
-        summaries = _collect(futures, finished, on_result)
+        # the workers are started by submit(), with SIGINT held back until their handler is in
+        # place (a Ctrl-C while one still imports would print its traceback), and the pool's
+        # semaphores made whole (one half made would leak); this process's own Ctrl-C is
+        # delivered as the block ends
+        with sigint_deferred():
+            starts = context.SimpleQueue()
+            pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))),
+                                       mp_context=context, initializer=_worker_start,
+                                       initargs=(starts,))
+            for number, job in enumerate(jobs):
+                submitted.append(pool.submit(_run_job, job, output_root, *task, number=number))
+                futures[submitted[-1]] = job
+        summaries = _collect(futures, _completed(futures, submitted, starts, on_start, ready),
+                             on_result)
     except BaseException:
         # Cancelled here, not only through shutdown(cancel_futures=True): the pool's
         # manager thread cancels through a weak reference to the pool, which may be gone
         # by the time it looks, and then every queued design would still be built.
         for future in futures:
             future.cancel()
-        pool.shutdown(wait=False, cancel_futures=True)
+        if pool is not None:
+            _stop_workers(pool, starts, ready)
         raise
     pool.shutdown()
     return summaries
+
+
+#: Seconds the local workers have, once interrupted, to stop their designs and end.
+_STOP_GRACE_SECONDS = 5.0
+
+
+def _stop_workers(pool, starts, ready: set, grace: float = _STOP_GRACE_SECONDS) -> None:
+    """Interrupt every worker of ``pool`` and wait for it to end (SIGKILL after ``grace``).
+
+    A busy worker kills its design's process group and removes its staging folder (see
+    :func:`_worker_start`); an idle one ends with the pool. A worker that has not told
+    ``starts`` it is ready (still importing, SIGINT held back) holds no design and never
+    will (it takes the interrupt sent here before it tells), so it is killed at once
+    rather than waited for. Waiting for the others means none is left unpickling its
+    pool's semaphores after this process has removed them (which printed a
+    FileNotFoundError traceback from each and broke the pool), and every child is reaped.
+    """
+    import signal
+
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError):
+            os.kill(process.pid, signal.SIGINT)
+    with contextlib.suppress(OSError, EOFError, ValueError):
+        while not starts.empty():
+            pid, number = starts.get()
+            if number == _READY:
+                ready.add(pid)
+    for process in processes:
+        if process.pid not in ready:
+            with contextlib.suppress(OSError, ValueError):
+                process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+    deadline = time.monotonic() + grace
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError, AssertionError):
+            process.join(max(0.0, deadline - time.monotonic()))
+            if process.exitcode is None:
+                process.kill()   # its design's process sees the lifeline end and kills its group
+                process.join()
 
 
 def _run_dask(jobs, output_root, task, scheduler, on_result):
@@ -252,9 +318,11 @@ def run_batch(jobs: Sequence[DesignJob], output_root: str | os.PathLike = "outpu
         # the paper's on 2 cores, imports warmed: 18.2 -> 16.6 s, the same files)
         build_kwargs.setdefault("parallel", False)
     task = (build, build_kwargs, timeout, bool(isolate))
-    if scheduler:
-        summaries = _run_dask(jobs, root, task, scheduler, on_result)
-    else:
-        summaries = _run_local(jobs, root, task, workers, on_result, on_start)
-    _clean_staging(root, {job.name for job in jobs})
+    try:
+        if scheduler:
+            summaries = _run_dask(jobs, root, task, scheduler, on_result)
+        else:
+            summaries = _run_local(jobs, root, task, workers, on_result, on_start)
+    finally:   # interrupted too: what a killed design left
+        _clean_staging(root, {job.name for job in jobs})
     return sorted(summaries, key=_order)

@@ -400,18 +400,18 @@ def _child_main(arguments: list) -> None:
 
 def _child_build(params: dict, output_root: str, sending) -> None:
     """In the child: build ``params`` into ``output_root``, events to ``sending``."""
-    owner = os.getpid()
+    from cadgen.processes import Interrupts
 
-    def stop(signum, frame):
-        if os.getpid() != owner:   # a build worker forked from here: end quietly
-            os._exit(EXIT_STOPPED)
-        raise KeyboardInterrupt
-
-    signal.signal(signal.SIGTERM, stop)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the server decides when to stop
+    # SIGTERM from the server stops the build (raised again if a library swallows it; a
+    # build worker forked from here ends quietly); SIGINT is the server's to decide
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    interrupts = Interrupts(signals=(signal.SIGTERM,)).install()
     start = time.perf_counter()
     try:
-        done = _build_in_child(params, Path(output_root), sending)
+        try:
+            done = _build_in_child(params, Path(output_root), sending)
+        finally:
+            interrupts.stopping = True   # not raised again while the answer is sent
     except KeyboardInterrupt:
         done = _done(EXIT_STOPPED, error="the build was stopped (the studio is closing)")
     except BaseException as error:   # a bug: one line here, the traceback in a crash file

@@ -82,11 +82,34 @@ def run_studio(file: str | Path | None = None, *, port: int = 0, open_browser: b
             import webbrowser
 
             webbrowser.open(url)
-        server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on",
-                                               access_log=False))
+        server = _server_class(uvicorn)(uvicorn.Config(
+            app, log_level="warning", lifespan="on", access_log=False,
+            timeout_graceful_shutdown=GRACEFUL_SHUTDOWN_SECONDS))
         server.run(sockets=[listener])
     finally:
         listener.close()
+
+
+#: Seconds the server waits, once stopping, for requests still being answered (a slow
+#: evaluation) before it cancels them.
+GRACEFUL_SHUTDOWN_SECONDS = 2.0
+
+
+def _server_class(uvicorn):
+    """uvicorn's server, stopping the builds first when it stops: a build's event stream
+    (an open request while the page watches the build) ends only with the build, and
+    uvicorn waits for open requests before the app's own shutdown would stop it."""
+
+    class StudioServer(uvicorn.Server):
+        async def shutdown(self, sockets=None):
+            import asyncio
+
+            state = getattr(self.config.app.state, "studio", None)
+            if state is not None and state.jobs is not None:
+                await asyncio.to_thread(state.jobs.shutdown)
+            await super().shutdown(sockets=sockets)
+
+    return StudioServer
 
 
 def serve_in_thread(path: Path | None = None, *, output_root: Path = Path("outputs"),

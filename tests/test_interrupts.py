@@ -1,0 +1,337 @@
+"""Ctrl-C at any moment: one line, exit 130, nothing half-written, no process left.
+
+The end-to-end tests send SIGINT to the command's whole process group, as a terminal's Ctrl-C
+does, at moments named by the command's own progress lines (not by a delay, which a busy
+second core would shift): the window where a build imports trimesh and matplotlib, each
+stage's start, the writing; a batch before its workers are ready, at each design's start.
+The unit tests drive :class:`cadgen.processes.Interrupts` with a stand-in for a library
+that swallows KeyboardInterrupt (trimesh's ``except BaseException`` around its imports).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from cadgen.processes import Interrupts, release_deferred_sigint, sigint_deferred
+from tests.helpers import reference_text, with_keys
+
+ROOT = Path(__file__).resolve().parents[1]
+CADGEN = Path(sys.executable).with_name("cadgen")
+POSIX = pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups (POSIX)")
+#: Generous: these bound a hang, not the latency (measured by scripts/interrupt_latency.py).
+TIMEOUT = 120
+
+
+# ----------------------------------------------------------------------------- units
+def _swallowing(seconds: float) -> bool:
+    """A library that catches everything for ``seconds``; True if it ran to its end."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        try:
+            time.sleep(0.002)
+        except BaseException:
+            pass
+    return True
+
+
+def _build_like(swallow_seconds: float, work_seconds: float) -> bool:
+    """A build: an import that swallows everything (trimesh's ``except BaseException``
+    around its optional imports), then normal work; True if it ran to its end."""
+    try:
+        time.sleep(swallow_seconds)
+    except BaseException:
+        pass
+    end = time.monotonic() + work_seconds
+    while time.monotonic() < end:
+        time.sleep(0.01)
+    return True
+
+
+@POSIX
+def test_an_interrupt_a_library_swallows_is_raised_again():
+    with Interrupts(repeat_seconds=0.05) as interrupts:
+        threading.Timer(0.1, os.kill, (os.getpid(), signal.SIGINT)).start()
+        with pytest.raises(KeyboardInterrupt):
+            _build_like(1.0, 60.0)   # the swallowed interrupt must not let it run on
+        assert interrupts.seen
+
+
+@POSIX
+def test_a_second_interrupt_does_not_cut_a_cleanup_short():
+    steps = []
+    with Interrupts(repeat_seconds=0.01) as interrupts:
+        with pytest.raises(KeyboardInterrupt):
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(10)   # interrupted here
+            finally:
+                # a second Ctrl-C while the first unwinds, and time for the watchdog to look
+                os.kill(os.getpid(), signal.SIGINT)
+                for step in range(20):
+                    time.sleep(0.01)
+                    steps.append(step)
+        interrupts.stopping = True
+    assert steps == list(range(20))
+
+
+@POSIX
+def test_an_inactive_process_only_remembers_the_interrupt():
+    busy = {"now": False}
+    with Interrupts(repeat_seconds=0.01, active=lambda: busy["now"]) as interrupts:
+        os.kill(os.getpid(), signal.SIGINT)
+        assert _swallowing(0.2)   # idle: nothing raised, not even by the watchdog
+        assert interrupts.seen
+        busy["now"] = True
+        with pytest.raises(KeyboardInterrupt):   # then busy: the watchdog raises it
+            _build_like(0.0, 60.0)
+        busy["now"] = False
+
+
+@POSIX
+def test_a_child_started_while_sigint_is_deferred_holds_it_until_released():
+    # the child reports what it sees: SIGINT pending (not delivered) until it releases it
+    code = ("import os, signal, sys, time\n"
+            "signal.signal(signal.SIGINT, lambda *a: print('handled', flush=True))\n"
+            "print('ready', flush=True); sys.stdin.readline()\n"
+            "print('pending' if signal.SIGINT in signal.sigpending() else 'none', flush=True)\n"
+            "from cadgen.processes import release_deferred_sigint\n"
+            "release_deferred_sigint(); time.sleep(0.2)\n")
+    with sigint_deferred():
+        child = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
+                                 stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "ready"
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate("go\n", timeout=TIMEOUT)
+    assert out.split() == ["pending", "handled"]
+    assert child.returncode == 0
+
+
+@POSIX
+def test_the_deferred_sigint_of_this_thread_arrives_as_the_block_ends():
+    held = False
+    with Interrupts() as interrupts:
+        with pytest.raises(KeyboardInterrupt):
+            with sigint_deferred():
+                # to this thread (a signal to the process may go to another thread, which
+                # does not block it: the block is for the children started in this one)
+                signal.pthread_kill(threading.get_ident(), signal.SIGINT)
+                time.sleep(0.05)   # held back: nothing raised in the block
+                held = True
+        interrupts.stopping = True
+    assert held and interrupts.seen
+    release_deferred_sigint()   # (unblocked already: harmless)
+
+
+# ----------------------------------------------------------------------------- commands
+def _alive_in_group(group: int) -> list[str]:
+    """The processes of ``group`` still alive (zombies are dead), read from /proc."""
+    alive = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()   # state, ppid, pgrp, ...
+        if int(fields[2]) == group and fields[0] != "Z":
+            alive.append(f"{entry.name} {stat[:stat.rindex(')') + 1]}")
+    return alive
+
+
+def interrupt_at(args, moment: str, tmp_path: Path, after: float = 0.0):
+    """Run the real script in its own process group and SIGINT the group once a stderr line
+    matches ``moment`` (then ``after`` s more): (exit code, stderr, signalled?)."""
+    process = subprocess.Popen([str(CADGEN), *map(str, args)], cwd=tmp_path,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    lines, signalled = [], threading.Event()
+
+    def read():
+        for line in process.stderr:
+            lines.append(line)
+            if not signalled.is_set() and re.search(moment, line):
+                time.sleep(after)
+                try:
+                    os.killpg(process.pid, signal.SIGINT)
+                    signalled.set()
+                except ProcessLookupError:   # it ended first
+                    pass
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    process.stdout.read()
+    process.wait(timeout=TIMEOUT)
+    reader.join(TIMEOUT)
+    deadline = time.monotonic() + 2.0    # every process it started ends with it
+    while _alive_in_group(process.pid) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _alive_in_group(process.pid), _alive_in_group(process.pid)
+    return process.returncode, "".join(lines), signalled.is_set()
+
+
+def _no_traceback_and_one_line(stderr: str) -> None:
+    assert "Traceback" not in stderr and "Error" not in stderr, stderr[-3000:]
+    lines = [line for line in stderr.splitlines() if not line.startswith("[")]  # progress
+    assert lines == ["cadgen: interrupted"], stderr[-3000:]
+
+
+PLANTER = ROOT / "params" / "xin2024-planter.toml"
+#: Build moments: the window where trimesh and matplotlib are imported (between the
+#: drivetrain's end and the teeth's start), each later stage's start, and the writing.
+BUILD_MOMENTS = [("drivetrain: ok", 0.0), ("drivetrain: ok", 0.15), ("teeth: started", 0.0),
+                 ("parts: started", 0.0), (r"plots: (started|1/)", 0.0),
+                 ("write: started", 0.0)]
+
+
+@POSIX
+@pytest.mark.parametrize("moment, after", BUILD_MOMENTS,
+                         ids=[f"{m.split(':')[0]}+{a}s" for m, a in BUILD_MOMENTS])
+def test_ctrl_c_during_a_build_leaves_nothing(moment, after, tmp_path):
+    out = tmp_path / "out"
+    code, stderr, signalled = interrupt_at(
+        ["build", PLANTER, "--output-dir", out, "--no-cache"], moment, tmp_path, after)
+    assert signalled, stderr[-2000:]
+    assert code == 130, stderr[-3000:]
+    _no_traceback_and_one_line(stderr)
+    left = sorted(p.name for p in out.iterdir()) if out.exists() else []
+    if re.search(r"write: ok", stderr):    # the signal came as the folder was swapped in
+        assert left == ["xin2024-planter"] and (out / left[0] / "report.json").is_file()
+    else:
+        assert left == [], left   # no folder, no staging folder
+
+
+GRID = ROOT / "params" / "grids" / "l2-sweep.toml"
+#: Batch moments: before any design starts (workers still importing), as the first and
+#: the second design start; each design a full build.
+BATCH_MOMENTS = [(r"^\[0/\d+\]", 0.0), ("started l2-sweep-001", 0.0),
+                 ("started l2-sweep-002", 0.3)]
+
+
+def _check_batch_interrupted(code, stderr, signalled, out):
+    assert signalled, stderr[-2000:]
+    assert code == 130, stderr[-3000:]
+    _no_traceback_and_one_line(stderr)
+    left = sorted(p.name for p in out.iterdir()) if out.exists() else []
+    assert not [name for name in left if name.startswith(".")], left   # no staging
+    done = set(re.findall(r"^\[\d+/\d+\] (\S+) ok ", stderr, re.MULTILINE))
+    for name in left:   # a design already built is whole; the others were stopped
+        assert (out / name / "report.json").is_file(), name
+    assert set(left) <= done
+    return left
+
+
+@POSIX
+@pytest.mark.parametrize("moment, after", BATCH_MOMENTS, ids=["queued", "first", "second"])
+def test_ctrl_c_stops_a_batch(moment, after, tmp_path):
+    out = tmp_path / "out"
+    code, stderr, signalled = interrupt_at(
+        ["batch", "--grid", GRID, "--output-dir", out, "--workers", "2"], moment, tmp_path,
+        after)
+    _check_batch_interrupted(code, stderr, signalled, out)
+
+
+@POSIX
+def test_ctrl_c_after_a_design_finished_keeps_it_whole(tmp_path):
+    # metrics-only designs (quick), interrupted as the first one is reported done
+    base = tmp_path / "base.toml"
+    base.write_text(with_keys(reference_text(), "scene", effects='["metrics"]'),
+                    encoding="utf-8")
+    grid = tmp_path / "grid.toml"
+    grid.write_text(f'base = "{base.name}"\nname = "quick"\n[grid]\n'
+                    f'"planter.L2" = [180.0, 182.0, 184.0, 186.0, 188.0, 190.0, 192.0, 194.0]\n',
+                    encoding="utf-8")
+    out = tmp_path / "out"
+    code, stderr, signalled = interrupt_at(
+        ["batch", "--grid", grid, "--output-dir", out, "--workers", "2"], r"^\[1/8\] quick",
+        tmp_path)
+    left = _check_batch_interrupted(code, stderr, signalled, out)
+    assert left and len(left) < 8
+
+
+@POSIX
+def test_ctrl_c_stops_an_optimisation(tmp_path):
+    study = ROOT / "params" / "studies" / "planter-margins.toml"
+    code, stderr, signalled = interrupt_at(
+        ["optimize", study, "--workers", "2", "--output-dir", tmp_path / "out"],
+        r"generation 1\b", tmp_path)
+    assert signalled and code == 130, stderr[-3000:]
+    _no_traceback_and_one_line(stderr)
+    assert not (tmp_path / "out").exists() or list((tmp_path / "out").iterdir()) == []
+
+
+def _descendants(pid: int) -> set[int]:
+    """Every process descended from ``pid``, from /proc (whatever group it leads)."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            parents[int(entry.name)] = int(stat[stat.rindex(")") + 2:].split()[1])
+    found, frontier = set(), {pid}
+    while frontier:
+        frontier = {child for child, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat[stat.rindex(")") + 2] != "Z"
+
+
+@POSIX
+@pytest.mark.parametrize("moment", ["drivetrain", "teeth"])
+def test_ctrl_c_stops_the_studio_and_its_build(moment, tmp_path):
+    import json
+    import urllib.request
+
+    server = subprocess.Popen([str(CADGEN), "studio", PLANTER, "--no-browser", "--output-dir",
+                               str(tmp_path / "out")], cwd=tmp_path, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        url = re.search(r"http://\S+", server.stdout.readline()).group(0)
+        base, token = url.split("/?token=")
+        headers = {"X-Cadgen-Token": token, "Content-Type": "application/json"}
+
+        def call(path, body=None):
+            request = urllib.request.Request(base + path, headers=headers, data=body,
+                                             method="POST" if body else "GET")
+            return urllib.request.urlopen(request, timeout=TIMEOUT)
+
+        params = json.loads(call("/api/design").read())["params"]
+        job = json.loads(call("/api/build", json.dumps({"params": params}).encode()).read())
+        events = call(job["events"])
+        for line in events:   # server-sent events: "data: {...}"
+            if line.startswith(b"data:") and json.loads(line[5:]).get("stage") == moment:
+                break
+        started = _descendants(server.pid)   # the build's process and its workers
+        assert started
+        os.killpg(server.pid, signal.SIGINT)
+        _, stderr = server.communicate(timeout=TIMEOUT)
+    finally:
+        if server.poll() is None:
+            os.killpg(server.pid, signal.SIGKILL)
+    assert server.returncode == 130, stderr[-3000:]
+    assert "Traceback" not in stderr and stderr.strip().splitlines()[-1] == "cadgen: interrupted"
+    deadline = time.monotonic() + 2.0
+    while any(_alive(pid) for pid in started) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [pid for pid in started if _alive(pid)]
+    out = tmp_path / "out"
+    assert not out.exists() or not [p for p in out.iterdir() if p.name != ".gitkeep"], \
+        list(out.iterdir())
