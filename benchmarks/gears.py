@@ -46,6 +46,19 @@ from kinematics.pitch_curves import polar_perimeter, solve_closure
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_OUTPUT = ROOT / "docs" / "gears.md"
+#: The line after which the output file holds hand-written text (the profile shift's section):
+#: kept as it is when the tables are generated again.
+HAND_WRITTEN = "<!-- hand-written below: kept by python -m benchmarks.gears -->"
+
+
+def _hand_written(path: Path) -> str:
+    """The hand-written end of ``path`` (from :data:`HAND_WRITTEN` on), or nothing."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError:
+        return ""
+    start = text.find(HAND_WRITTEN)
+    return "" if start < 0 else "\n\n" + text[start:]
 DEFAULT_JSON = Path(__file__).resolve().parent / "results" / "gears.json"
 
 TEETH = 24
@@ -549,7 +562,7 @@ def main(argv: list[str] | None = None) -> int:
 
     lines = report(case, ours, peer, peer_error, accuracy, scallop, fillets, dxf, meta)
     args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text("\n".join(lines), encoding="utf-8")
+    args.output.write_text("\n".join(lines) + _hand_written(args.output), encoding="utf-8")
     closure = case["closure"]
     result = dict(
         machine=meta,

@@ -15,7 +15,7 @@ from kinematics.planting import PlantingMechanism
 from cadgen.solids.housings import housing_circles
 
 __all__ = ["build_mechanism", "planting_events", "targets_of", "evaluate", "pricking_design",
-           "pricking_field"]
+           "pricking_field", "planting_circular_module"]
 
 
 @lru_cache(maxsize=16)
@@ -77,7 +77,11 @@ def pricking_design(params):
     """The inverse design of a validated pricking file (cached: validation and analysis share it)."""
     from kinematics.pricking import design_pricking
 
+    from kinematics.profile_shift import shift_key
+
     trajectory, gears = params.trajectory, params.gears
+    shifts, given = gears.profile_shift.resolved(), gears.profile_shift.given()
+    names = ("sun", "intermediate 1", "intermediate 2", "planet")
     return design_pricking(
         np.asarray(trajectory.points, dtype=float), rocker=params.linkage.rocker,
         degree=trajectory.degree, centre=trajectory.sun_centre,
@@ -85,7 +89,9 @@ def pricking_design(params):
         exponent=gears.split_exponent, module=gears.module,
         pressure_angle=gears.pressure_angle_rad, addendum=gears.addendum,
         min_ratio=gears.min_ratio, grid=params.resolution.inverse_grid,
-        max_scale_change=gears.max_scale_change)
+        max_scale_change=gears.max_scale_change,
+        profile_shift={name: shifts[shift_key(name)] for name in names},
+        shifts_given=[name for name in names if shift_key(name) in given])
 
 
 def pricking_field(params, design=None):
@@ -97,3 +103,14 @@ def pricking_field(params, design=None):
     return field_motion(design, carrier_speed_rpm=field.carrier_speed_rpm,
                         forward_speed=field.forward_speed, depth=field.depth,
                         inclinations_deg=field.inclinations_deg)
+
+
+def planting_circular_module(params, mechanism: PlantingMechanism | None = None) -> float:
+    """The module (mm) the teeth stage cuts the planting trains' circular gears with: the
+    file's ``gears.circular_module`` or the automatic choice (the validation's profile-shift
+    check needs their tooth counts; the housings size them the same way)."""
+    from cadgen.solids.housings import planting_modules   # cadgen.gears.circular's, as sized
+
+    mechanism = mechanism or build_mechanism(params)
+    return float(planting_modules(mechanism, params.pitch_curve.teeth,
+                                  params.gears.circular_module)[1])

@@ -20,6 +20,8 @@ from .pricking_gears import (EQUAL_PERIMETER, STRETCH_MERGE_DEG, GearStage, Pitc
                              _pitch_functions, _ratio_extreme, equal_perimeter_exponent)
 from .pricking_motion import (TWO_PI, CarrierMotion, Linkage, carrier_motion, link_lengths,
                               travel_direction_problems)
+from .profile_shift import (ModuleSetting, ShiftedGear, concave_advice, shift_key,
+                            undercut_advice)
 from .spline import ClosedCurve
 
 __all__ = ["Linkage", "CarrierMotion", "GearStage", "PitchCurveReport", "PrickingDesign",
@@ -153,7 +155,7 @@ def _motion_and_split(points, *, degree, centre, rocker, a, l, exponent, min_rat
 
 
 def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pressure_angle,
-                 addendum, min_ratio, grid, sense):
+                 addendum, min_ratio, grid, sense, shifts=None):
     (curve, linkage, motion, modes, geometry, w, constant, lowest_ratio,
      highest_ratio) = _motion_and_split(points, degree=degree, centre=centre, rocker=rocker,
                                         a=a, l=l, exponent=exponent, min_ratio=min_ratio,
@@ -165,14 +167,18 @@ def _design_once(points, *, degree, centre, rocker, a, l, exponent, module, pres
     grid_phi1 = phi1_start + sense * (np.arange(grid) + 0.5) * (TWO_PI / grid)
     grid_v = motion.invert(grid_phi1)
     common = dict(module=module, pressure_angle=pressure_angle, addendum=addendum)
+    shifts = shifts or {}
     gears = {
-        "sun": _gear_report("sun", 1, "drive", geometry, constant, w, sun, grid_v, **common),
+        "sun": _gear_report("sun", 1, "drive", geometry, constant, w, sun, grid_v, **common,
+                            shift=shifts.get("sun", 0.0)),
         "intermediate 1": _gear_report("intermediate 1", 1, "driven", geometry, constant, w,
-                                       int1, grid_v, **common),
+                                       int1, grid_v, **common,
+                                       shift=shifts.get("intermediate 1", 0.0)),
         "intermediate 2": _gear_report("intermediate 2", 2, "drive", geometry, 1.0 / constant,
-                                       1.0 - w, int2, grid_v, **common),
+                                       1.0 - w, int2, grid_v, **common,
+                                       shift=shifts.get("intermediate 2", 0.0)),
         "planet": _gear_report("planet", 2, "driven", geometry, 1.0 / constant, 1.0 - w, planet,
-                               grid_v, **common),
+                               grid_v, **common, shift=shifts.get("planet", 0.0)),
     }
     # body polar angles on the grid: sun phi1, intermediates pi - T1 and -T1, planet pi + T
     stage1_turn = _integral_function(geometry, lambda v: geometry.stage_ratio(v, constant, w)[0])
@@ -209,32 +215,45 @@ def _stretch_text(stretch) -> str:
     return f"carrier progress {span} (tip near {stretch['near']})"
 
 
-def _findings(stages, curve):
+def _findings(stages, curve, *, pressure_angle, addendum, module, given=()):
+    """The pitch curves' findings, each with what cuts it or avoids it in the file's terms:
+    the pinion cutter the teeth stage takes on a concave stretch (or the module from which one
+    fits), the profile shift (V-zero with the gear's mate) or module that ends an undercut."""
+    setting = ModuleSetting("gears.module", module)
+    smoother = ("use the degree-5 curve (trajectory.degree = 5) or move the type-value points "
+                "there (trajectory.points) onto a smoother loop" if curve.degree == 3 else
+                "move the type-value points there (trajectory.points) onto a smoother loop")
     notes = []
     for stage in stages:
-        for gear in (stage.drive, stage.driven):
+        for gear, mate in ((stage.drive, stage.driven), (stage.driven, stage.drive)):
+            path = f"gears.{gear.name.replace(' ', '_')}"
             if not gear.convex:
                 where = "; ".join(_stretch_text(s) for s in gear.concave_stretches)
-                advice = ("use the degree-5 curve, or move the type-value points there onto a "
-                          "smoother loop" if curve.degree == 3 else
-                          "move the type-value points there onto a smoother loop")
+                cutter, fits = concave_advice(1 / -gear.curvature_min, module, setting=setting)
                 notes.append(Problem(
-                    f"gears.{gear.name.replace(' ', '_')}", "concave_pitch_curve",
+                    path, "concave_pitch_curve",
                     f"the {gear.name} gear's pitch curve is concave (curvature down to "
-                    f"{gear.curvature_min:.4f} 1/mm) at {where}: a rack cannot cut it there, it "
-                    f"needs a shaper cutter of pitch radius below {1 / -gear.curvature_min:.1f} mm; "
-                    f"or {advice}"))
+                    f"{gear.curvature_min:.4f} 1/mm) at {where}: a rack cannot cut it there"
+                    + cutter + {"cutter": f"; to cut it with the rack instead, {smoother}",
+                                "module": f"; or {smoother}"}.get(fits, f"; so {smoother}")))
             if gear.undercut:
                 # a prediction for rack cutting, so a warning: the cut teeth's measured root
                 # thickness (the gear checks of stage teeth) decides whether it fails
+                shifted = ShiftedGear(gear.name, gear.convex_radius_of_curvature_min, module,
+                                      gear.profile_shift, shaped=not gear.convex)
+                linked = [ShiftedGear(mate.name, mate.convex_radius_of_curvature_min, module,
+                                      mate.profile_shift, sign=-1, shaped=not mate.convex)]
                 notes.append(Problem(
-                    f"gears.{gear.name.replace(' ', '_')}", "undercut",
+                    path, "undercut",
                     f"the {gear.name} gear's pitch curve bends to a radius of curvature of "
                     f"{gear.convex_radius_of_curvature_min:.2f} mm, below the rack undercut limit "
-                    f"{gear.undercut_limit:.2f} mm (m ha*/sin^2 alpha): rack-cut teeth are "
-                    "predicted to be undercut there (a warning; the cut teeth's root thickness, "
-                    "checked in stage teeth, decides); a smaller module, a profile shift or a "
-                    "shaper cutter would avoid it", stage="teeth"))
+                    f"{gear.undercut_limit:.2f} mm (m (ha* - x) / sin^2 alpha, x = "
+                    f"{gear.profile_shift:g}): rack-cut teeth are predicted to be undercut there "
+                    "(a warning; the cut teeth's root thickness, checked in stage teeth, decides)"
+                    + undercut_advice(shifted, linked, pressure_angle=pressure_angle,
+                                      addendum=addendum, setting=setting,
+                                      given={shift_key(name) for name in given}),
+                    stage="teeth"))
     return notes
 
 
@@ -257,7 +276,8 @@ def design_pricking(points, *, rocker: float, degree: int = 3, centre=(0.0, 0.0)
                     pressure_angle: float = np.radians(20.0), addendum: float = 1.0,
                     min_ratio: float = 0.05, grid: int = 720, min_teeth: int = 8,
                     sense: int | None = None,
-                    max_scale_change: float = 0.05) -> PrickingDesign:
+                    max_scale_change: float = 0.05, profile_shift=None,
+                    shifts_given=None) -> PrickingDesign:
     """Inverse design of the pricking mechanism from the type-value points of its tip loop.
 
     The design is scaled about the sun centre so that stage 1 holds a whole
@@ -266,6 +286,11 @@ def design_pricking(points, *, rocker: float, degree: int = 3, centre=(0.0, 0.0)
     The scale may differ from 1 by at most ``max_scale_change`` (the drawn loop
     is the designer's; rounding to whole teeth is meant to move it slightly):
     beyond that, ``module_does_not_fit`` names the modules that would.
+    ``profile_shift`` maps gear names (``"sun"``, ``"intermediate 1"``, ...) to their profile
+    shift coefficients (default 0): each gear's rack undercut limit is
+    ``m (ha* - x) / sin^2(alpha)`` (:mod:`kinematics.profile_shift`); ``shifts_given`` names
+    the gears whose shift the file states (the others' follow from a mate's), so that the
+    advice changes those (default: every gear with a non-zero shift).
 
     Raises
     ------
@@ -293,12 +318,16 @@ def design_pricking(points, *, rocker: float, degree: int = 3, centre=(0.0, 0.0)
     if l is not None:
         options["l"] = l * scale
     options["rocker"] = rocker * scale
+    options["shifts"] = dict(profile_shift or {})
     result = _checked_design(centre + scale * (points - centre), options)
     (curve, linkage, motion, modes, w, stages, grid_tables, deviation, closure, i_min, i_max,
      functions) = result
     teeth_2 = max(min_teeth, int(round(stages[1].perimeter / (np.pi * module))))
     modules = (stages[0].perimeter / (np.pi * teeth_1), stages[1].perimeter / (np.pi * teeth_2))
-    findings = _findings(stages, curve) + _forward_findings(deviation, grid)
+    given = (shifts_given if shifts_given is not None
+             else [name for name, x in (profile_shift or {}).items() if x])
+    findings = (_findings(stages, curve, pressure_angle=pressure_angle, addendum=addendum,
+                          module=module, given=given) + _forward_findings(deviation, grid))
     return PrickingDesign(curve, linkage, motion, modes, w, stages, float(scale),
                           (teeth_1, teeth_2), modules, grid_tables, deviation, abs(closure),
                           i_min, i_max, findings, functions)

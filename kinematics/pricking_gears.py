@@ -45,6 +45,7 @@ class PitchCurveReport:
     undercut_limit: float
     undercut: bool
     table: dict = field(repr=False)
+    profile_shift: float = 0.0   # x the undercut limit is for: m (ha* - x) / sin^2(alpha)
 
 
 @dataclass(frozen=True)
@@ -238,7 +239,7 @@ def _stretches(v, mask, geometry, curve, motion):
 
 
 def _gear_report(name, stage, role, geometry, constant, exponent, factor, grid_v, module,
-                 pressure_angle, addendum):
+                 pressure_angle, addendum, shift=0.0):
     v = geometry.samples
     rho, d_rho, dd_rho, psi_rate, psi_rate2 = geometry.gear_curve(v, constant, exponent, role,
                                                                   factor)
@@ -250,7 +251,7 @@ def _gear_report(name, stage, role, geometry, constant, exponent, factor, grid_v
     curvature = np.sign(psi_rate) * bend / speed**3
     deviation = np.degrees(np.arctan2(np.abs(d_rho), np.abs(tangential)))
     concave = curvature < 0.0
-    limit = module * addendum / np.sin(pressure_angle) ** 2
+    limit = module * (addendum - shift) / np.sin(pressure_angle) ** 2   # rack, profile shift x
     convex_radius_min = float(1.0 / curvature[~concave].max()) if (~concave).any() else np.inf
     tight = (~concave) & (curvature > 1.0 / limit)
     table_rho, _, _, _, _ = geometry.gear_curve(grid_v, constant, exponent, role, factor)
@@ -263,7 +264,7 @@ def _gear_report(name, stage, role, geometry, constant, exponent, factor, grid_v
         pressure_angle_deviation_max_deg=float(deviation.max()),
         convex_radius_of_curvature_min=convex_radius_min, undercut_limit=float(limit),
         undercut=bool(tight.any()),
-        table={"radius": table_rho})
+        table={"radius": table_rho}, profile_shift=float(shift))
 
 
 def _integral_function(geometry, rate):

@@ -314,7 +314,7 @@ def _pair_fingerprint(pair, samples: int = FINGERPRINT_SAMPLES) -> dict:
 
 def stage_key(name: str, pair, teeth, system, *, flank_points: int, bore_radius: float,
               force_shaper: bool, poses: int, span: float | None, circular: bool,
-              drive=None) -> str:
+              drive=None, shifts=(0.0, 0.0)) -> str:
     """The hex SHA-256 of everything that determines one stage of a gear train.
 
     Parameters
@@ -326,7 +326,8 @@ def stage_key(name: str, pair, teeth, system, *, flank_points: int, bore_radius:
         breaks and each gear's contact functions sampled).
     teeth : int or (int, int)
     system : ToothSystem
-        Every field (module, pressure angle, addendum, dedendum, tip radius, backlash).
+        Every field (module, pressure angle, addendum, dedendum, tip radius, backlash,
+        profile shift: the pair's basic rack; each gear's own shift is in ``shifts``).
     flank_points : int
     bore_radius : float
     force_shaper : bool
@@ -337,6 +338,8 @@ def stage_key(name: str, pair, teeth, system, *, flank_points: int, bore_radius:
     circular : bool
     drive : (float, (GearProfile, GearCheck, spaces)), optional
         A drive gear carried from another mesh: its phase and the whole cut gear.
+    shifts : (float, float)
+        The (drive, driven) profile-shift coefficients the gears are cut with.
 
     Returns
     -------
@@ -354,6 +357,7 @@ def stage_key(name: str, pair, teeth, system, *, flank_points: int, bore_radius:
         "force_shaper": bool(force_shaper), "poses": int(poses),
         "span": None if span is None else float(span), "circular": bool(circular),
         "drive": None if drive is None else (float(drive[0]), drive[1]),
+        "shifts": tuple(float(x) for x in shifts),
     })
     return digest.hexdigest()
 

@@ -12,6 +12,7 @@ stage of a train is phased at its own start contact, so the train's phases agree
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -20,6 +21,8 @@ import numpy as np
 import shapely.errors
 
 from kinematics.errors import DesignError
+from kinematics.profile_shift import (MIN_SHAPER_TEETH, MIN_TIP_THICKNESS, SHAPER_CLEARANCE,
+                                      shift_key, shaper_teeth as _fitting_shaper)  # noqa: F401
 
 from cadgen.gears.teeth import GearProfile
 from cadgen.gears.teeth import CutterChoice, ToothSystem, gear_outline
@@ -31,12 +34,10 @@ __all__ = ["PitchPair", "GearCheck", "GeneratedPair", "generate_pair", "generate
            "mating_phase", "circle_pair", "MIN_SHAPER_TEETH", "MIN_ROOT_THICKNESS",
            "FAILING_PROBLEMS"]
 
-#: The smallest pinion cutter considered (fewer teeth would undercut itself).
-MIN_SHAPER_TEETH = 10
-#: A shaper's pitch radius is kept below this fraction of the tightest concave radius it cuts.
-SHAPER_CLEARANCE = 0.9
-#: A tooth whose tip is thinner than this many modules is pointed.
-MIN_TIP_THICKNESS = 0.25
+# MIN_SHAPER_TEETH (the smallest pinion cutter considered), SHAPER_CLEARANCE (a shaper's pitch
+# radius stays below this fraction of the tightest concave radius it cuts) and MIN_TIP_THICKNESS
+# (modules: a thinner tip is pointed) live in kinematics.profile_shift: the pricking findings
+# give the same advice without importing cadgen.
 #: The undercut policy (both mechanisms): an undercut tooth is a warning while its remaining
 #: root thickness (its narrowest section between the pitch curve and the root fillet, measured
 #: on the cut outline) is at least this many modules, and a failure below it. A full tooth is
@@ -47,8 +48,9 @@ MIN_TIP_THICKNESS = 0.25
 #: teeth the usual Lewis tables list. Measured here, a circular gear cut by the standard rack
 #: meets it with 8 teeth (1.30 m) and not with 7 (1.20 m).
 MIN_ROOT_THICKNESS = 1.25
-#: Gear-check problems that fail the design; every other one is a warning.
-FAILING_PROBLEMS = frozenset({"undercut_root_too_thin"})
+#: Gear-check problems that fail the design; every other one is a warning. A positive profile
+#: shift whose cut teeth are pointed is refused: the file asked for it.
+FAILING_PROBLEMS = frozenset({"undercut_root_too_thin", "profile_shift_pointed"})
 
 
 @dataclass(frozen=True)
@@ -138,6 +140,8 @@ class GearCheck:
     problems: list = field(default_factory=list)
     undercut_root_thickness_min: float | None = None   # of the undercut teeth (None: none)
     root_thickness_limit: float = 0.0                   # MIN_ROOT_THICKNESS modules, mm
+    profile_shift: float = 0.0                          # x the gear was cut with (modules)
+    convex_radius_min: float = np.inf                   # smallest convex radius of curvature, mm
 
     @property
     def failing(self) -> list:
@@ -147,6 +151,9 @@ class GearCheck:
 
 @dataclass(frozen=True)
 class GeneratedPair:
+    """A pair as cut: ``system`` the pair's basic rack, ``systems`` each gear's own (the
+    basic rack with that gear's profile shift)."""
+
     pair: PitchPair
     curves: tuple
     system: ToothSystem
@@ -155,6 +162,7 @@ class GeneratedPair:
     checks: tuple
     phases: tuple
     spaces: tuple = ()
+    systems: tuple = ()
 
 
 def _choose_cutters(curve: ArcLengthCurve, teeth: int, system: ToothSystem, phase: float,
@@ -166,8 +174,7 @@ def _choose_cutters(curve: ArcLengthCurve, teeth: int, system: ToothSystem, phas
     concave_min = float(curvature.min())
     shaper_teeth = None
     if concave_min < 0:
-        tightest = 1.0 / -concave_min
-        shaper_teeth = min(int(np.floor(2 * SHAPER_CLEARANCE * tightest / system.module)), 40)
+        shaper_teeth = _fitting_shaper(1.0 / -concave_min, system.module)
     elif force_shaper:
         shaper_teeth = 24  # a convex curve takes any pinion cutter: a common size
     cutters, concave = [], []
@@ -235,13 +242,12 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
         looped = not _simple(shapely.LineString(boundary).intersection(pitch_region))
         if tight or looped:
             undercut.append(k)
-    heights = np.linspace(-(system.dedendum - system.tip_radius) * system.module, 0.0, 6)
     dense = np.arange(8192) * (curve.length / 8192)
     frame = (dense, *curve.frame(dense)[::2])
     root = np.min([_tooth_thickness(frame, gear, teeth, system.pitch, phase, h)
-                   for h in heights], axis=0)
+                   for h in system.root_heights], axis=0)
     tip = _tooth_thickness(frame, gear, teeth, system.pitch, phase,
-                           system.addendum_height - 1e-4 * system.module)
+                           system.tip_height - 1e-4 * system.module)
     pointed = [k for k, t in enumerate(tip) if not t > MIN_TIP_THICKNESS * system.module]
     # pressure-angle deviation: angle between the radius and the pitch curve's normal
     radial = point / np.linalg.norm(point, axis=1, keepdims=True)
@@ -251,23 +257,24 @@ def _check_gear(name, curve, teeth, system, phase, outline, spaces, concave, con
     limit = MIN_ROOT_THICKNESS * system.module
     undercut_root = float(root[undercut].min()) if undercut else None
     problems += _undercut_problems(name, undercut, root, limit, system)
-    if pointed:
-        problems.append(("pointed_teeth", f"the {name} gear's teeth {_list(pointed)} are pointed "
-                         f"(tip thickness down to {tip.min():.3f} mm, below "
-                         f"{MIN_TIP_THICKNESS:g} m): use fewer teeth (a larger module) or a "
-                         "smaller addendum"))
+    problems += _pointed_problems(name, pointed, float(tip.min()), system)
     kinds = {c.kind for c in cutters}
     return GearCheck(
         convex=not concave, concave_teeth=concave, curvature_min=concave_min,
         cutter=" and ".join(sorted(kinds)), shaper_teeth=shaper_teeth if "shaper" in kinds else None,
         undercut_teeth=undercut, root_thickness_min=float(root.min()), pointed_teeth=pointed,
         tip_thickness_min=float(tip.min()), pressure_angle_deviation_max_deg=deviation,
-        problems=problems, undercut_root_thickness_min=undercut_root, root_thickness_limit=limit)
+        problems=problems, undercut_root_thickness_min=undercut_root, root_thickness_limit=limit,
+        profile_shift=float(system.profile_shift),
+        convex_radius_min=float(1.0 / curvature.max()) if curvature.max() > 0 else np.inf)
 
 
 def _undercut_problems(name, undercut, root, limit, system) -> list:
     """The undercut finding: a warning while the undercut teeth keep ``limit`` mm of root
-    thickness (``root``: per tooth), a failure below it; none without undercut teeth."""
+    thickness (``root``: per tooth), a failure below it; none without undercut teeth.
+
+    What avoids it (a profile shift, more teeth) depends on the gear's mates and on the
+    mechanism's parameters: :func:`cadgen.gears.advice.advise_train` appends it."""
     if not undercut:
         return []
     root = np.asarray(root, dtype=float)
@@ -279,12 +286,28 @@ def _undercut_problems(name, undercut, root, limit, system) -> list:
         return [("undercut_root_too_thin",
                  f"the {name} gear's teeth {_list(thin)} are undercut below the "
                  f"root-thickness limit: {measured}, under {limit:.3f} mm "
-                 f"({MIN_ROOT_THICKNESS:g} m); use a smaller module (more teeth), a "
-                 "profile shift, or a shaper cutter")]
+                 f"({MIN_ROOT_THICKNESS:g} m)")]
     return [("undercut", f"the {name} gear's teeth {_list(undercut)} are "
              f"undercut; {measured}, at least the {limit:.3f} mm "
-             f"({MIN_ROOT_THICKNESS:g} m) limit, so a warning: a smaller module "
-             "(more teeth), a profile shift or a shaper cutter would avoid it")]
+             f"({MIN_ROOT_THICKNESS:g} m) limit, so a warning")]
+
+
+def _pointed_problems(name, pointed, tip, system) -> list:
+    """The pointed-teeth finding: a warning (``pointed_teeth``), with the means that is the
+    gear system's own (``gears.addendum``), or, for a gear cut with a positive profile shift,
+    a failure (``profile_shift_pointed``: the file's shift is refused where it is measured).
+    :func:`cadgen.gears.advice.advise_train` adds the tooth count's and the shift's values."""
+    if not pointed:
+        return []
+    measured = (f"the {name} gear's teeth {_list(pointed)} are pointed (tip thickness down to "
+                f"{tip:.3f} mm, below {MIN_TIP_THICKNESS:g} m = "
+                f"{MIN_TIP_THICKNESS * system.module:.3f} mm)")
+    if system.profile_shift > 0:
+        return [("profile_shift_pointed",
+                 f"{measured} at the profile shift {system.profile_shift:+g} it is cut with "
+                 f"(gears.profile_shift.{shift_key(name)}, given or its mate's opposite): a "
+                 "smaller shift thickens them")]
+    return [("pointed_teeth", f"{measured}: a smaller gears.addendum would thicken them")]
 
 
 def _simple(geometry) -> bool:
@@ -341,8 +364,7 @@ def _check_problems(name, concave, concave_min, shaper_teeth, system):
         return [("concave_too_tight",
                  f"the {name} gear's pitch curve is concave down to a radius of "
                  f"{1 / -concave_min:.2f} mm (teeth {_list(concave)}): no pinion cutter "
-                 f"of at least {MIN_SHAPER_TEETH} teeth fits (module {system.module:.3f}); "
-                 "use a smaller module (more teeth) or a rounder pitch curve")]
+                 f"of at least {MIN_SHAPER_TEETH} teeth fits at module {system.module:.3f} mm")]
     return []
 
 
@@ -391,7 +413,7 @@ def generate_gear(name, curve: ArcLengthCurve, teeth: int, system: ToothSystem, 
 def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
                   system: ToothSystem | None = None, force_shaper: bool = False,
                   bore_radius: float = 0.0, flank_points: int = 48, drive_phase=None,
-                  drive_gear=None, symmetric: bool = True) -> GeneratedPair:
+                  drive_gear=None, symmetric: bool = True, shifts=None) -> GeneratedPair:
     """Tooth both gears of a pair, phased to assemble at ``tau = 0``, with their checks.
 
     ``teeth`` is one count or (drive, driven). The module follows from the
@@ -400,11 +422,23 @@ def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
     check, spaces) so a gear in two meshes is cut once with one phase. A circular pair
     (:func:`circle_pair`) is cut on exact circles, one tooth turned (``symmetric``, see
     :func:`generate_gear`).
+
+    ``shifts`` (drive, driven) are the gears' profile-shift coefficients; by default the
+    system's for the drive and its opposite for the driven gear. They must sum to zero
+    (V-zero): the pitch curves and the centre distance stay as they are, and so do the
+    phases (tooth centres do not move).
     """
     teeth = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
     curves = (pair.curve(0), pair.curve(1))
     if system is None:
         system = ToothSystem(module if module is not None else curves[0].length / (np.pi * teeth[0]))
+    if shifts is None:
+        shifts = (system.profile_shift, -system.profile_shift)
+    shifts = tuple(float(x) for x in shifts)
+    if len(shifts) != 2 or not abs(shifts[0] + shifts[1]) <= 1e-12:
+        raise ValueError(f"the profile shifts of a pair must sum to zero (V-zero), not {shifts}")
+    systems = tuple(dataclasses.replace(system, profile_shift=x)
+                    if x != system.profile_shift else system for x in shifts)
     if drive_phase is None:  # a tooth centred on the start contact
         drive_phase = float(curves[0].arc_of_source(np.array([0.0]))[0])
     elif drive_gear is not None:
@@ -415,8 +449,8 @@ def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
     phases = (drive_phase, mating_phase(curves[0], drive_phase, curves[1], system.pitch))
     options = dict(force_shaper=force_shaper, bore_radius=bore_radius, flank_points=flank_points,
                    symmetric=symmetric)
-    first = drive_gear or generate_gear(pair.names[0], curves[0], teeth[0], system, phases[0],
-                                        **options)
-    second = generate_gear(pair.names[1], curves[1], teeth[1], system, phases[1], **options)
+    first = drive_gear or generate_gear(pair.names[0], curves[0], teeth[0], systems[0],
+                                        phases[0], **options)
+    second = generate_gear(pair.names[1], curves[1], teeth[1], systems[1], phases[1], **options)
     return GeneratedPair(pair, curves, system, teeth, (first[0], second[0]),
-                         (first[1], second[1]), phases, (first[2], second[2]))
+                         (first[1], second[1]), phases, (first[2], second[2]), systems)

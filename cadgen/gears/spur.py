@@ -146,7 +146,7 @@ def _tooth_piece(curve, teeth, system, phase, cutters, outline):
     pitch = 2 * math.pi / teeth
     middle = curve.start + phase / curve.radius
     chords = math.ceil(BLANK_POINTS / teeth)
-    tip = curve.radius + system.addendum_height
+    tip = curve.radius + system.tip_height
     wedge = shapely.Polygon(np.vstack([[0.0, 0.0], _arc(tip, middle, middle + pitch, chords)]))
     shaped = any(c.kind == "shaper" for c in cutters)
     reach = _SHAPER_REACH if shaped else _RACK_REACH
@@ -198,7 +198,7 @@ def circular_gear(name, curve: CircleCurve, teeth: int, system, phase: float, *,
     import shapely
 
     from cadgen.gears.pairs import (MIN_TIP_THICKNESS, MIN_ROOT_THICKNESS, GearCheck,
-                                    _undercut_problems, _list)
+                                    _pointed_problems, _undercut_problems)
     from cadgen.gears.teeth import CutterChoice, GearProfile
 
     if not isinstance(curve, CircleCurve):
@@ -223,18 +223,12 @@ def circular_gear(name, curve: CircleCurve, teeth: int, system, phase: float, *,
     pitch_disc = shapely.Polygon(curve.polyline(4096))
     looped = not _simple_clip(shapely.LineString(space).intersection(pitch_disc))
     undercut = list(range(teeth)) if (tight or looped) else []
-    heights = np.linspace(-(system.dedendum - system.tip_radius) * system.module, 0.0, 6)
-    root = min(_width(piece, curve.radius + h, middle, pitch) for h in heights)
-    tip = _width(piece, curve.radius + system.addendum_height - 1e-4 * system.module, middle,
-                 pitch)
+    root = min(_width(piece, curve.radius + h, middle, pitch) for h in system.root_heights)
+    tip = _width(piece, curve.radius + system.tip_height - 1e-4 * system.module, middle, pitch)
     pointed = list(range(teeth)) if not tip > MIN_TIP_THICKNESS * system.module else []
     limit = MIN_ROOT_THICKNESS * system.module
     problems = _undercut_problems(name, undercut, [root] * teeth, limit, system)
-    if pointed:
-        problems.append(("pointed_teeth", f"the {name} gear's teeth {_list(pointed)} are pointed "
-                         f"(tip thickness down to {tip:.3f} mm, below "
-                         f"{MIN_TIP_THICKNESS:g} m): use fewer teeth (a larger module) or a "
-                         "smaller addendum"))
+    problems += _pointed_problems(name, pointed, tip, system)
     check = GearCheck(
         convex=True, concave_teeth=[], curvature_min=1.0 / curve.radius, cutter=cutter.kind,
         shaper_teeth=shaper_teeth, undercut_teeth=undercut, root_thickness_min=float(root),
@@ -242,7 +236,8 @@ def circular_gear(name, curve: CircleCurve, teeth: int, system, phase: float, *,
         # the radius is the circle's normal everywhere: the pressure angle never deviates
         pressure_angle_deviation_max_deg=0.0, problems=problems,
         undercut_root_thickness_min=float(root) if undercut else None,
-        root_thickness_limit=limit)
+        root_thickness_limit=limit, profile_shift=float(system.profile_shift),
+        convex_radius_min=float(curve.radius))
     return profile, check, spaces
 
 

@@ -19,6 +19,11 @@ Where the envelope of one tooth space loops back on itself (a swallowtail) the
 cutter's tip undercuts the flank; the loop lies inside the swept region and the
 union of the space's pieces is the true cut. The gear is the blank (bounded by
 the addendum curve) minus the union of all tooth spaces (shapely).
+
+A profile shift x (:attr:`ToothSystem.profile_shift`) moves the rack's outline ``x m``
+outward (y) while its rolling line stays on the pitch curve, gives a shaper the shift -x,
+and moves the blank's addendum curve out by ``x m``: on a circle, the textbook shifted spur
+gear (``tests/test_profile_shift.py``).
 """
 
 from __future__ import annotations
@@ -53,6 +58,12 @@ class ToothSystem:
     backlash : float
         Circumferential backlash on the pitch curve (mm) taken off each tooth of
         this gear (a pair's backlash is the sum of its two gears').
+    profile_shift : float
+        Profile shift coefficient x (times the module; positive away from the gear's
+        centre): the cutter's teeth stand ``x m`` further out while it rolls on the pitch
+        curve, so the teeth are ``2 x m tan(alpha)`` thicker on it, the tip and the root
+        ``x m`` further out, and the undercut limit is ``m (ha* - x) / sin^2(alpha)``
+        (:mod:`kinematics.profile_shift`).
     """
 
     module: float
@@ -61,11 +72,16 @@ class ToothSystem:
     dedendum: float = 1.25
     tip_radius: float = 0.38
     backlash: float = 0.0
+    profile_shift: float = 0.0
 
     def __post_init__(self):
+        shift = self.profile_shift
         checks = {"module": self.module > 0, "pressure_angle": 0 < self.pressure_angle < np.pi / 3,
                   "addendum": self.addendum > 0, "dedendum": self.dedendum > 0,
-                  "tip_radius": self.tip_radius >= 0, "backlash": self.backlash >= 0}
+                  "tip_radius": self.tip_radius >= 0, "backlash": self.backlash >= 0,
+                  # the tip stays outside the pitch curve, the root inside it
+                  "profile_shift": (bool(np.isfinite(shift))
+                                    and -self.addendum < shift < self.dedendum)}
         bad = [name for name, ok in checks.items() if not ok]
         if bad:
             raise ValueError(f"tooth system: {', '.join(f'{n} = {getattr(self, n)!r}' for n in bad)} "
@@ -84,9 +100,31 @@ class ToothSystem:
         return self.dedendum * self.module
 
     @property
+    def shift_height(self) -> float:
+        """``x m``: how far out of the pitch curve the cutter's reference line runs (mm)."""
+        return self.profile_shift * self.module
+
+    @property
+    def tip_height(self) -> float:
+        """The blank's tip (addendum curve) above the pitch curve: ``(ha* + x) m``."""
+        return (self.addendum + self.profile_shift) * self.module
+
+    @property
+    def root_depth(self) -> float:
+        """The root below the pitch curve: ``(hf* - x) m``."""
+        return (self.dedendum - self.profile_shift) * self.module
+
+    @property
     def undercut_radius(self) -> float:
-        """Smallest radius of curvature a rack cuts without undercut: ``m ha* / sin^2(alpha)``."""
-        return self.addendum_height / np.sin(self.pressure_angle) ** 2
+        """Smallest radius of curvature a rack cuts without undercut: ``m (ha* - x) / sin^2(alpha)``."""
+        return (self.addendum - self.profile_shift) * self.module / np.sin(self.pressure_angle) ** 2
+
+    @property
+    def root_heights(self) -> np.ndarray:
+        """Heights (mm, from the pitch curve) the root thickness is measured at: from the top
+        of the root fillet (``-(hf* - rho_f - x) m``) up to the pitch curve, six of them."""
+        low = -(self.dedendum - self.tip_radius - self.profile_shift) * self.module
+        return np.linspace(min(low, 0.0), 0.0, 6)
 
 
 @dataclass(frozen=True)
@@ -104,8 +142,10 @@ def rack_tooth_outline(system: ToothSystem, *, flank_points: int = 48, fillet_po
     Returns
     -------
     xy : (k, 2) float
-        Rack coordinates: x along the pitch line, y outward from the gear (the
-        tooth points to -y, its tip at ``-dedendum``).
+        Rack coordinates: x along the pitch line (the line that rolls on the pitch
+        curve), y outward from the gear (the tooth points to -y, its tip at
+        ``-dedendum + x m``: the whole outline stands ``x m`` out for a profile shift x;
+        ``top`` is measured from the rack's own reference line).
     normal : (k, 2) float
         Unit normals pointing out of the rack tooth (into the gear's material).
     """
@@ -136,6 +176,8 @@ def rack_tooth_outline(system: ToothSystem, *, flank_points: int = 48, fillet_po
     xy = np.vstack([left, arc, flat, (arc * mirror)[::-1], (left * mirror)[::-1]])
     normal = np.vstack([left_normal, arc_normal, flat_normal, (arc_normal * mirror)[::-1],
                         (left_normal * mirror)[::-1]])
+    if system.profile_shift:   # (an unshifted rack keeps its exact numbers: no + 0.0)
+        xy[:, 1] += system.shift_height
     return xy, normal
 
 
@@ -216,15 +258,23 @@ def _shaper_tooth(system: ToothSystem, teeth: int, flank_points: int, fillet_poi
     circle equal to the gear's space (``p/2 + backlash``), tip at ``r + dedendum``
     rounded with ``tip_radius`` tangent to flank and tip circle; the flank runs
     down to the base circle or the cutter's own root, whichever is higher.
+
+    A profile shift x of the gear is the cutter's own shift -x (the pair cutter-gear is
+    V-zero, rolling on the pitch circle and the pitch curve): its teeth
+    ``2 x m tan(alpha)`` thinner at the pitch circle, tip and root ``x m`` lower. On a
+    circle this cuts exactly the shifted spur gear a rack shifted by ``x m`` cuts.
     """
     from kinematics.scalar import brentq
 
     m, alpha = system.module, system.pressure_angle
     radius = teeth * m / 2
     base = radius * np.cos(alpha)
-    tip = radius + system.dedendum_depth
+    tip = radius + system.dedendum_depth - system.shift_height
     rounding = system.tip_radius * m
-    half = (system.pitch / 2 + system.backlash) / (2 * radius)  # half tooth angle at the pitch circle
+    thickness = system.pitch / 2 + system.backlash
+    if system.profile_shift:   # (an unshifted cutter keeps its exact numbers)
+        thickness -= 2 * system.shift_height * np.tan(alpha)
+    half = thickness / (2 * radius)  # half tooth angle at the pitch circle
     involute = np.tan(alpha) - alpha
 
     def flank(rad):  # polar angle of the upper (+) flank at radius rad
@@ -250,7 +300,7 @@ def _shaper_tooth(system: ToothSystem, teeth: int, flank_points: int, fillet_poi
 
     # the cutter reaches 0.6 m deeper than the gear's addendum, like the rack: below its base
     # circle its flank is radial (a real cutter's root), which still sweeps the gear's tips
-    root = radius - system.addendum_height - 0.6 * m
+    root = radius - system.tip_height - 0.6 * m
     low = max(base * (1 + 1e-9), root)
     touch = brentq(gap, low, tip) if rounding > 0 else tip
     arc_centre = point(touch) - rounding * normal_at(touch)
@@ -314,7 +364,7 @@ def gear_outline(curve: ArcLengthCurve, teeth: int, system: ToothSystem, *, phas
                          f"of module {system.module:g} ({teeth * pitch:.6f} mm)")
     s = np.arange(blank_points) * (curve.length / blank_points)
     point, _, outward = curve.frame(s)
-    blank = shapely.Polygon(point + system.addendum_height * outward)
+    blank = shapely.Polygon(point + system.tip_height * outward)
     spaces, polygons = [], []
     for k in range(teeth):
         centre = phase + (k + 0.5) * pitch
@@ -408,7 +458,7 @@ def simulated_rack_cut(curve: ArcLengthCurve, teeth: int, system: ToothSystem, *
     pitch = system.pitch
     s = np.arange(blank_points) * (curve.length / blank_points)
     point, _, outward = curve.frame(s)
-    blank = shapely.Polygon(point + system.addendum_height * outward)
+    blank = shapely.Polygon(point + system.tip_height * outward)
     tooth, _ = rack_tooth_outline(system, flank_points=24, fillet_points=16,
                                   top=system.addendum_height + 2.0 * system.module)
     centres = phase + (np.arange(teeth) + 0.5) * pitch
@@ -443,7 +493,7 @@ def simulated_shaper_cut(curve: ArcLengthCurve, teeth: int, system: ToothSystem,
     cutter, radius = _shaper_polygon(system, cutter_teeth)
     s = np.arange(blank_points) * (curve.length / blank_points)
     point, _, outward = curve.frame(s)
-    blank = shapely.Polygon(point + system.addendum_height * outward)
+    blank = shapely.Polygon(point + system.tip_height * outward)
     first = phase + 0.5 * pitch
     cuts = [_placed_shaper(cutter, radius, curve, position, first) for position in
             first + np.arange(teeth * positions_per_pitch) * (pitch / positions_per_pitch)]

@@ -17,6 +17,9 @@ import numpy as np
 
 from kinematics.errors import DesignError
 
+from kinematics.profile_shift import shift_key
+
+from cadgen.gears.advice import advise_train, planting_hints, pricking_hints
 from cadgen.gears.circular import _radius_hint, circular_module, planting_circular_radii
 from cadgen.gears.pairs import (FAILING_PROBLEMS, MIN_ROOT_THICKNESS, PitchPair, circle_pair,
                                 generate_pair)
@@ -63,13 +66,27 @@ def _system(cutting, module) -> ToothSystem:
                        backlash=cutting.backlash if cutting.backlash is not None else 0.0)
 
 
+def _shift_table(cutting) -> dict:
+    """``{gears.profile_shift key: x}`` of every gear, each mate's shift filled in (V-zero):
+    :meth:`cadgen.params.cutting.ShiftTable.resolved`; empty for a table without shifts."""
+    table = getattr(cutting, "profile_shift", None)
+    return dict(table.resolved()) if table is not None else {}
+
+
+def _shifts(table: dict, pair) -> tuple:
+    """The (drive, driven) profile shifts of ``pair``'s gears."""
+    return tuple(float(table.get(shift_key(name), 0.0)) for name in pair.names)
+
+
 #: Poses of the meshing check over one tooth pitch of a circular pair.
 CIRCULAR_PITCH_POSES = 32
 
 
-def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=False, cache=None):
+def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=False, cache=None,
+           shifts=(0.0, 0.0)):
     """One pair cut, checked and meshed (tip relief if needed); looked up in ``cache`` first
-    (a :class:`~cadgen.gears.cache.GearCache` or None) and stored there once computed."""
+    (a :class:`~cadgen.gears.cache.GearCache` or None) and stored there once computed.
+    ``shifts``: the (drive, driven) profile shifts (V-zero)."""
     bore = cutting.bore_diameter / 2
     force_shaper = cutting.cutter == "shaper"
     counts = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
@@ -83,7 +100,7 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
 
         key = stage_key(name, pair, teeth, system, flank_points=cutting.flank_points,
                         bore_radius=bore, force_shaper=force_shaper, poses=poses, span=span,
-                        circular=circular, drive=drive)
+                        circular=circular, drive=drive, shifts=shifts)
         stored = cache.get(key)
         if stored is not None:
             generated, report, relief = stored
@@ -91,7 +108,7 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
             return GearStage(name, dataclasses.replace(generated, pair=pair), report, placement,
                              relief)
     stage = _cut_stage(name, pair, teeth, system, bore, force_shaper, cutting.flank_points,
-                       placement, drive, poses, span)
+                       placement, drive, poses, span, shifts)
     if cache is not None:   # a stage that raised (DesignError) never gets here: not cached
         cache.put(key, (dataclasses.replace(stage.generated, pair=None), stage.meshing,
                         stage.relief))
@@ -99,9 +116,9 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
 
 
 def _cut_stage(name, pair, teeth, system, bore, force_shaper, flank_points, placement, drive,
-               poses, span):
+               poses, span, shifts=(0.0, 0.0)):
     options = dict(system=system, bore_radius=bore, flank_points=flank_points,
-                   force_shaper=force_shaper)
+                   force_shaper=force_shaper, shifts=shifts)
     if drive is not None:
         generated = generate_pair(pair, teeth, drive_phase=drive[0], drive_gear=drive[1],
                                   **options)
@@ -176,6 +193,7 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     """
     cut = _report_to(progress, 5)
     cutting = params.gears
+    shifts = _shift_table(cutting)
     a = mechanism.centre_distance
     teeth = params.pitch_curve.teeth
     pair = planting_pair(mechanism)
@@ -183,7 +201,7 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     C = np.asarray(mechanism.positions(np.array([0.0]), points=("C",))["C"][0])
     module_nc = mechanism.module(teeth)   # the spec: module from perimeter and z
     stages = [_stage("non-circular pair", pair, teeth, _system(cutting, module_nc), cutting,
-                     (box, C), cache=cache)]
+                     (box, C), cache=cache, shifts=_shifts(shifts, pair))]
     cut(stages[-1].name)
     # circular gears: gearbox 2's 1:1 pair and train 1's set with converted ratio -1
     radii = planting_circular_radii(mechanism)
@@ -194,26 +212,30 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     system = _system(cutting, module)
     z = [int(round(2 * x / module)) for x in radii]
     D = C + a * np.array([math.cos(box), math.sin(box)])
-    stages.append(_stage("1:1 pair (D to E)", circle_pair(("gear D", "planet gear E"), mechanism.r, mechanism.r),
-                         (z[4], z[4]), system, cutting, (box, D), circular=True, cache=cache))
+    pair = circle_pair(("gear D", "planet gear E"), mechanism.r, mechanism.r)
+    stages.append(_stage("1:1 pair (D to E)", pair, (z[4], z[4]), system, cutting, (box, D),
+                         circular=True, cache=cache, shifts=_shifts(shifts, pair)))
     cut(stages[-1].name)
     carrier = mechanism.phi0
     line = np.array([math.cos(carrier), math.sin(carrier)])
-    first = _stage("train 1: sun to idler 1", circle_pair(("sun", "idler 1"), radii[0], radii[1]),
-                   (z[0], z[1]), system, cutting, (carrier, np.zeros(2)), circular=True,
-                   cache=cache)
+    pair = circle_pair(("sun", "idler 1"), radii[0], radii[1])
+    first = _stage("train 1: sun to idler 1", pair, (z[0], z[1]), system, cutting,
+                   (carrier, np.zeros(2)), circular=True, cache=cache,
+                   shifts=_shifts(shifts, pair))
     cut(first.name)
-    second = _stage("train 1: idler 1 to idler 2",
-                    circle_pair(("idler 1", "idler 2"), radii[1], radii[2]), (z[1], z[2]), system,
+    pair = circle_pair(("idler 1", "idler 2"), radii[1], radii[2])
+    second = _stage("train 1: idler 1 to idler 2", pair, (z[1], z[2]), system,
                     cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated),
-                    circular=True, cache=cache)
+                    circular=True, cache=cache, shifts=_shifts(shifts, pair))
     cut(second.name)
-    third = _stage("train 1: idler 2 to planet",
-                   circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3]), (z[2], z[3]),
+    pair = circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3])
+    third = _stage("train 1: idler 2 to planet", pair, (z[2], z[3]),
                    system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
-                   drive=_carry(second.generated), circular=True, cache=cache)
+                   drive=_carry(second.generated), circular=True, cache=cache,
+                   shifts=_shifts(shifts, pair))
     cut(third.name)
-    return GearTrain(tuple(stages + [first, second, third]), cache=cache)
+    train = GearTrain(tuple(stages + [first, second, third]), cache=cache)
+    return advise_train(train, planting_hints(mechanism, teeth, cutting))
 
 
 def pricking_train(params, design, progress=None, cache=None) -> GearTrain:
@@ -224,6 +246,7 @@ def pricking_train(params, design, progress=None, cache=None) -> GearTrain:
     """
     cut = _report_to(progress, 2)
     cutting = params.gears
+    shifts = _shift_table(cutting)
     motion, link = design.motion, design.linkage
     functions, breaks = design.cycle_functions()
     stages = []
@@ -238,11 +261,13 @@ def pricking_train(params, design, progress=None, cache=None) -> GearTrain:
         system = _system(cutting, design.modules[index])
         try:
             stages.append(_stage(f"stage {index + 1}", pair, design.teeth[index], system, cutting,
-                                 (carrier, centre + index * link.a * line), cache=cache))
+                                 (carrier, centre + index * link.a * line), cache=cache,
+                                 shifts=_shifts(shifts, pair)))
         except DesignError as error:  # reported with the gear and the reason; others go on
             failures += [(f"stage {index + 1}", problem) for problem in error.problems]
         cut(f"stage {index + 1}")
-    return GearTrain(tuple(stages), tuple(failures), cache=cache)
+    train = GearTrain(tuple(stages), tuple(failures), cache=cache)
+    return advise_train(train, pricking_hints(design, cutting))
 
 
 def _placements(train: GearTrain):
@@ -267,7 +292,8 @@ def train_report(train: GearTrain) -> dict:
     for profile, check, stage, _ in train.gears:
         gears.append({
             "gear": profile.name, "stage": stage.name, "teeth": profile.teeth,
-            "module_mm": profile.module, "cutter": check.cutter,
+            "module_mm": profile.module, "profile_shift": check.profile_shift,
+            "cutter": check.cutter,
             "shaper_teeth": check.shaper_teeth, "convex": check.convex,
             "concave_teeth": check.concave_teeth, "curvature_min_per_mm": check.curvature_min,
             "undercut_teeth": check.undercut_teeth, "root_thickness_min_mm": check.root_thickness_min,
@@ -304,5 +330,5 @@ ROOT_THICKNESS_POLICY = (
     f"an undercut tooth is a warning while its remaining root thickness is at least "
     f"{MIN_ROOT_THICKNESS:g} modules (80 % of the full tooth's pi m / 2, 63 % of its bending "
     "section by Lewis), a failure below it; the kinematic undercut finding (radius of "
-    "curvature below m ha* / sin^2 alpha) is a prediction for rack cutting, and the cut "
-    "teeth's measured root thickness decides")
+    "curvature below m (ha* - x) / sin^2 alpha, x the gear's profile shift) is a prediction "
+    "for rack cutting, and the cut teeth's measured root thickness decides")

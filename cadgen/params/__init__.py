@@ -53,6 +53,10 @@ not_allowed         a value outside a fixed set of choices: ``trajectory.degree`
 wall_too_thin       ``housing.wall`` below the 2-mm minimum (:data:`MIN_WALL`)
 ==================  =====================================================================
 
+And ``profile_shift_changes_centre_distance``: two ``gears.profile_shift`` values in one
+chain of meshes that do not alternate in sign (V-zero), at the second one, naming the pair
+(:mod:`cadgen.params.cutting`; the feasibility checks add ``profile_shift_pointed``).
+
 Where array problems are reported: an array item at its index
 (``field.inclinations_deg.1``); a type-value point that is not a pair of two finite
 numbers once, at the point's index (``trajectory.points.3``: ``wrong_type`` for a
@@ -119,7 +123,8 @@ from cadgen.params.pricking import (
     TrajectoryParameters,
 )
 from cadgen.params.cam import CamParameters, CamTimingParameters, DuckbillParameters, LeverParameters
-from cadgen.params.cutting import CuttingParameters
+from cadgen.params.cutting import (PROFILE_SHIFT_RANGE, CuttingParameters,
+                                   PlantingCuttingParameters, PlantingShifts, PrickingShifts)
 from cadgen.params.solids import MIN_WALL, GroundParameters, ShellParameters, SolidsParameters
 from cadgen.params.machine import (DEFAULT_BUILD_VOLUME, PROCESSES, MachineParameters,
                                    ManufacturingParameters, PrickingMachineParameters,
@@ -146,6 +151,10 @@ __all__ = [
     "PrickingParameters",
     "SplitExponent",
     "CuttingParameters",
+    "PlantingCuttingParameters",
+    "PlantingShifts",
+    "PrickingShifts",
+    "PROFILE_SHIFT_RANGE",
     "CamParameters",
     "DuckbillParameters",
     "LeverParameters",

@@ -7,6 +7,7 @@ the field path a designer should change, never raises for a bad design.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 from kinematics.errors import ConvergenceError, DesignError, Problem
 from kinematics.pitch_curves import pair_problems
@@ -26,7 +27,8 @@ def design_problems(params) -> list:
     """Every reason a structurally valid design cannot be built, as :class:`Problem` records.
 
     Checks: the pitch curve closes (and is not pointed); both non-circular
-    gears' smallest radii clear the cutting limit for the module; the planting
+    gears' smallest radii clear the cutting limit for the module; no profile
+    shift (``gears.profile_shift``) points a circular gear's teeth; the planting
     depth leaves the tip a way out of the soil; the duckbill linkage can open
     the mouth the pot needs; the cam's phases fit the revolution.
 
@@ -48,6 +50,9 @@ def design_problems(params) -> list:
     except ConvergenceError as error:
         return [Problem("pitch_curve", "closure_not_converged", str(error))]
     problems = pair_problems(closure, module)
+    if problems:
+        return problems
+    problems = shift_problems(params, planting_circular_sizes(params, mechanism))
     if problems:
         return problems
     from cadgen.design import planting_events
@@ -94,3 +99,59 @@ def _pricking_problems(params) -> list:
     except ConvergenceError as error:
         return [Problem("trajectory.points", "not_converged", str(error))]
     return []
+
+
+# ------------------------------------------------------------------------------ profile shift
+
+
+def planting_circular_sizes(params, mechanism) -> dict:
+    """``{gears.profile_shift key: (pitch radius, module)}`` (mm) of the planting trains'
+    circular gears, cut with the module the teeth stage takes."""
+    from cadgen.design import planting_circular_module
+
+    module = planting_circular_module(params, mechanism)
+    R, train = params.train.R, params.train
+    return {key: (float(radius), module) for key, radius in (
+        ("gear_D", train.r), ("planet_gear_E", train.r), ("sun", R), ("idler_1", R * train.i12),
+        ("idler_2", R * train.i13), ("train_1_planet", R))}
+
+
+def shift_problems(params, sizes: dict) -> list:
+    """``profile_shift_pointed`` for every circular gear whose profile shift (given, or the
+    opposite of a mate's) leaves its teeth pointed: the shifted spur gear's tip (closed form,
+    exact for a circular gear) thinner than ``MIN_TIP_THICKNESS`` modules. ``sizes``: key ->
+    (pitch radius, module). Reported at the path of the shift the file gives.
+
+    A non-circular gear's tip is thickest-to-thinnest along its curve; the closed form at its
+    tightest convex radius is only an estimate (measured on the paper's intermediate gear it
+    under-states the tip by 0.1 to 0.25 mm), so its teeth are judged where they are cut: the
+    teeth stage fails a shifted gear whose cut teeth are pointed (``profile_shift_pointed``).
+    """
+    from kinematics.profile_shift import (MIN_TIP_THICKNESS, largest_unpointed_shift,
+                                          tip_thickness)
+
+    gears = params.gears
+    table = gears.profile_shift
+    alpha = gears.pressure_angle_rad
+    problems = []
+    for key, shift in table.resolved().items():
+        if shift <= 0 or key not in sizes:
+            continue   # a negative shift thickens the tip
+        radius, module = sizes[key]
+        tip = tip_thickness(radius, module, alpha, gears.addendum, shift)
+        if tip >= MIN_TIP_THICKNESS * module:
+            continue
+        source = table.source(key)
+        largest = largest_unpointed_shift(radius, module, alpha, gears.addendum)
+        given = "" if source == key else f" (the opposite of its mate's, from {source})"
+        limit = (f"the largest shift that keeps {MIN_TIP_THICKNESS:g} m is "
+                 f"{math.floor(largest * 100) / 100:.2f}" if largest > 0
+                 else "it is pointed at any shift above 0")
+        state = f"a tip {tip:.3f} mm thick" if tip > 0 else "flanks that cross below the tip"
+        teeth = 2 * radius / module
+        problems.append(Problem(
+            f"gears.profile_shift.{source}", "profile_shift_pointed",
+            f"a profile shift of {shift:+g} on the {key.replace('_', ' ')} gear{given} makes its "
+            f"teeth pointed: {teeth:.4g} teeth of module {module:g} mm get {state}, below "
+            f"{MIN_TIP_THICKNESS:g} m ({MIN_TIP_THICKNESS * module:.3f} mm); {limit}"))
+    return problems

@@ -15,7 +15,7 @@ from pydantic import BeforeValidator, Field, field_validator
 from pydantic_core import PydanticCustomError
 
 from cadgen.params.cam import CamParameters
-from cadgen.params.cutting import CuttingParameters
+from cadgen.params.cutting import PlantingCuttingParameters
 from cadgen.params.scene import SceneParameters
 from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
 from cadgen.params.machine import MachineParameters, ManufacturingParameters
@@ -219,7 +219,7 @@ class PlantingParameters(_Table):
     housing: HousingParameters = HousingParameters()
     targets: DesignTargets = DesignTargets()
     resolution: ResolutionParameters = ResolutionParameters()
-    gears: CuttingParameters = CuttingParameters()
+    gears: PlantingCuttingParameters = PlantingCuttingParameters()
     cam: CamParameters = CamParameters()
     ground: GroundParameters = GroundParameters()
     solids: SolidsParameters = SolidsParameters()

@@ -17,7 +17,7 @@ from pydantic import BeforeValidator, Field, ValidationInfo, field_validator
 from pydantic_core import PydanticCustomError
 
 from cadgen.params._problems import _close_keys, _describe, _problems_error, _show
-from cadgen.params.cutting import CuttingParameters
+from cadgen.params.cutting import CuttingParameters, PrickingShifts
 from cadgen.params.scene import SceneParameters
 from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
 from cadgen.params.machine import ManufacturingParameters, PrickingMachineParameters
@@ -175,6 +175,9 @@ class GearParameters(CuttingParameters):
         0.05, gt=0, le=0.5,
         description="largest change of scale, as a fraction, the design may take so that "
                     "stage 1 holds whole teeth at the module (0.05 = 5 %)")
+    profile_shift: PrickingShifts = Field(
+        PrickingShifts(), description="profile shift coefficient by gear (V-zero: a mate takes "
+                                      "the opposite)")
 
     @field_validator("split_exponent", mode="before")
     @classmethod

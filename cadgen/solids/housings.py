@@ -73,7 +73,8 @@ def housing_circles(params, mechanism) -> list:
     shells = planting_shells(params, mechanism)
     circles = envelope_circles(
         mechanism, mechanism.module(params.pitch_curve.teeth), shells["gearbox2"].envelope,
-        circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].envelope)
+        circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].envelope,
+        shifts=params.gears.profile_shift.resolved())
     explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
     return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
             for c in circles]
@@ -81,7 +82,7 @@ def housing_circles(params, mechanism) -> list:
 
 def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: float, *,
                             circular_module: float | None = None,
-                            gearbox1_allowance: float | None = None):
+                            gearbox1_allowance: float | None = None, shifts=None):
     """Envelope circles of both gearboxes: the largest gear tip about each axis plus ``allowance``.
 
     Gearbox 2 holds the non-circular pair and the 1:1 pair: at C the central
@@ -92,6 +93,8 @@ def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: flo
     module's addendum; the other set is not modelled, so pass explicit radii
     when it is larger. ``allowance`` (mm) is the housing's clearance plus wall;
     ``gearbox1_allowance`` defaults to it, ``circular_module`` to ``module``.
+    ``shifts`` (``gears.profile_shift`` key -> x, resolved) moves a gear's tip out by its
+    positive shift, ``x m``; a negative one leaves the housing as for the standard gear.
     """
     closure = mechanism.closure
     a = closure.centre_distance
@@ -99,10 +102,17 @@ def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: flo
     R, r = mechanism.R, mechanism.r
     m_c = module if circular_module is None else circular_module
     outer1 = allowance if gearbox1_allowance is None else gearbox1_allowance
-    box2 = {"C": r_max + module + allowance,
-            "D": max(a - r_min + module, r + m_c) + allowance,
-            "E": r + m_c + allowance}
-    box1 = {"O": R + m_c + outer1, "A": R * mechanism.i12 + m_c + outer1,
-            "B": R * mechanism.i13 + m_c + outer1, "C": R + m_c + outer1}
+    shifts = shifts or {}
+
+    def tip(key, m):   # the addendum, grown by a positive profile shift (unshifted: m exactly)
+        shift = max(shifts.get(key, 0.0), 0.0)
+        return m + shift * m if shift else m
+
+    box2 = {"C": r_max + tip("central", module) + allowance,
+            "D": max(a - r_min + tip("intermediate", module), r + tip("gear_D", m_c)) + allowance,
+            "E": r + tip("planet_gear_E", m_c) + allowance}
+    box1 = {"O": R + tip("sun", m_c) + outer1, "A": R * mechanism.i12 + tip("idler_1", m_c) + outer1,
+            "B": R * mechanism.i13 + tip("idler_2", m_c) + outer1,
+            "C": R + tip("train_1_planet", m_c) + outer1}
     return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
             + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])
