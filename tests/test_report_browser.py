@@ -7,9 +7,15 @@ and fails in CI (``CI=true``), where ``.ci/run`` installs Chromium first.
 The checks (shared with ``scripts/report_screenshots.py``): nothing wider than the
 viewport (at 1280 px), every image loaded, the 3D view loaded the embedded
 GLB and drew it (pixels unlike its background), the animation's frame advances,
-no script error, and nothing fetched but the page itself.
+no script error, and nothing fetched but the page itself. Then the contents (they list
+every section, mark the one scrolled to, become a bar on a narrow window), the folding
+(a folded section is only its heading; the contents fold and unfold them all), the page
+with scripts off, and the 3D view's parts against solids/assembly.glb read by trimesh
+(every node, named, its box where the file places it). Waits are for conditions, never
+for a time.
 """
 
+import re
 import time
 from pathlib import Path
 
@@ -102,7 +108,9 @@ def test_animation_poses_are_the_kinematic_model_and_the_page_embeds_them():
     report = {"design": "x", "mechanism": "planting"}
     page = render_html(report, animation=data)
     assert page == render_html(report, animation=data)          # same input, same bytes
-    assert '<a href="#animation">' in page and "<script" not in render_html(report)
+    # without animation or 3D view, the only script is the contents' (cadgen/report/toc.js)
+    assert '<a href="#animation">' in page
+    assert re.findall(r"<script[^>]*>", render_html(report)) == ['<script id="cadgen-toc-script">']
 
 
 def test_viewer_takes_binary_gltf_only():
@@ -114,3 +122,133 @@ def test_viewer_takes_binary_gltf_only():
     section = viewer_section(b"glTF" + bytes(16))
     assert 'id="cadgen-glb">Z2xURg' in section and "CadgenThree" in section
     assert section.count("</script>") == 3   # the GLB, three.js, the viewer: none cut short
+
+
+# ---------------------------------------------------------------- contents, folding, the 3D view
+#: The page's anchors in order, from the DOM (an independent list of what the contents list).
+_ANCHORS_JS = """() => ['verdict'].concat(Array.from(document.querySelectorAll('main > section'))
+  .map(s => s.id))"""
+_CURRENT_JS = """() => { const a = document.querySelector('nav.toc a[aria-current]');
+  return a ? a.getAttribute('href').slice(1) : null; }"""
+#: Sections taller than most of the window (open ones): scrolled to the top, the one in view.
+_TALL_JS = """() => Array.from(document.querySelectorAll('main > section'))
+  .filter(s => s.getBoundingClientRect().height > 0.6 * window.innerHeight).map(s => s.id)"""
+
+
+def _open(browser, path, width=1280, scripts=True):
+    context = browser.new_context(viewport={"width": width, "height": 900},
+                                  java_script_enabled=scripts)
+    page = context.new_page()
+    page.goto(Path(path).resolve().as_uri(), wait_until="load")
+    return context, page
+
+
+@pytest.mark.parametrize("design", ["xin2024-planter", "kernel-a"], ids=["planting", "pricking"])
+def test_the_contents_list_every_section_and_mark_the_one_in_view(browser, reports, design):
+    context, page = _open(browser, reports[design])
+    try:
+        anchors = page.evaluate(_ANCHORS_JS)
+        links = page.eval_on_selector_all("nav.toc ol a", "l => l.map(a => a.hash.slice(1))")
+        assert links == anchors and len(anchors) >= 8
+        assert page.evaluate(_CURRENT_JS) == "verdict"
+        tall = page.evaluate(_TALL_JS)
+        for anchor in (tall[len(tall) // 2], tall[-1]):
+            page.evaluate(f"document.getElementById('{anchor}').scrollIntoView()")
+            page.wait_for_function(f"({_CURRENT_JS})() === '{anchor}'")
+            # the contents stay in sight beside the page, the marked link inside them
+            toc = page.locator("nav.toc").bounding_box()
+            mark = page.locator("nav.toc a[aria-current]").bounding_box()
+            assert toc["y"] == 0 and toc["x"] == 0 and toc["width"] < 300
+            assert 0 <= mark["y"] and mark["y"] + mark["height"] <= 900
+    finally:
+        context.close()
+
+
+def test_sections_fold_and_the_contents_fold_them_all(browser, reports):
+    context, page = _open(browser, reports["xin2024-planter"])
+    try:
+        height = page.evaluate("document.documentElement.scrollHeight")
+        anchor = page.evaluate(_TALL_JS)[0]
+        section, summary = page.locator(f"#{anchor}"), page.locator(f"#{anchor} summary")
+        fold = page.locator(f"#{anchor} details.fold")
+        assert section.bounding_box()["height"] > 3 * summary.bounding_box()["height"]
+        summary.click()
+        assert fold.get_attribute("open") is None
+        folded = section.bounding_box()["height"]
+        assert folded < summary.bounding_box()["height"] + 60   # the heading and its margins
+        assert page.evaluate("document.documentElement.scrollHeight") < height
+        # a link of the contents opens the folded section it leads to
+        page.locator(f"nav.toc a[href='#{anchor}']").click()
+        assert fold.get_attribute("open") is not None
+        page.locator("nav.toc button[data-fold='close']").click()
+        closed = page.evaluate("Array.from(document.querySelectorAll('details.fold'))"
+                               ".every(d => !d.open)")
+        assert closed and page.locator("header table").first.is_visible()   # the verdict stays
+        all_folded = page.evaluate("document.documentElement.scrollHeight")
+        assert all_folded < height / 3
+        page.locator("nav.toc button[data-fold='open']").click()
+        assert page.evaluate("Array.from(document.querySelectorAll('details.fold'))"
+                             ".every(d => d.open)")
+    finally:
+        context.close()
+
+
+def test_a_narrow_window_gets_the_contents_as_a_bar(browser, reports):
+    context, page = _open(browser, reports["xin2024-planter"], width=820)
+    try:
+        anchor = page.evaluate(_TALL_JS)[-1]
+        page.evaluate(f"document.getElementById('{anchor}').scrollIntoView()")
+        page.wait_for_function(f"({_CURRENT_JS})() === '{anchor}'")
+        bar = page.locator("nav.toc").bounding_box()
+        assert bar["y"] == 0 and bar["height"] < 80 and bar["width"] >= 800
+        # the marked link scrolled into the bar's view
+        mark = page.locator("nav.toc a[aria-current]").bounding_box()
+        assert 0 <= mark["x"] and mark["x"] + mark["width"] <= 820
+        # the section's heading is not under the bar
+        heading = page.locator(f"#{anchor} summary").bounding_box()
+        assert heading["y"] >= bar["height"] - 1
+    finally:
+        context.close()
+
+
+def test_the_page_reads_without_scripts(browser, reports):
+    context, page = _open(browser, reports["kernel-a"], scripts=False)
+    try:
+        links = page.locator("nav.toc ol a")
+        assert links.count() == page.locator("main > section").count() + 1
+        assert links.first.is_visible()
+        assert not page.locator("nav.toc .toc-fold").is_visible()   # needs the script
+        assert page.locator("header table").first.is_visible()
+        # a folded section opens by its heading, natively
+        folded = page.locator("details.fold:not([open])").first.element_handle()
+        folded.query_selector("summary").click()
+        assert folded.get_attribute("open") is not None
+    finally:
+        context.close()
+
+
+@pytest.mark.parametrize("design", ["xin2024-planter", "kernel-a"], ids=["planting", "pricking"])
+def test_the_3d_view_shows_every_part_of_the_file_named_and_placed(browser, reports, design):
+    import io
+
+    import numpy as np
+    import trimesh
+
+    glb = (reports[design].parent / "solids" / "assembly.glb").read_bytes()
+    scene = trimesh.load_scene(io.BytesIO(glb), file_type="glb", process=False)
+    expected = {}
+    for node in scene.graph.nodes_geometry:
+        transform, geometry = scene.graph[node]
+        placed = trimesh.transform_points(scene.geometry[geometry].vertices, transform)
+        expected[node] = np.r_[placed.min(axis=0), placed.max(axis=0)]
+    context, page = _open(browser, reports[design])
+    try:
+        page.wait_for_function("window.cadgenViewer && window.cadgenViewer.state === 'ready'")
+        parts = page.evaluate("window.cadgenViewer.parts")
+        embedded = page.evaluate("document.getElementById('cadgen-glb').textContent.length")
+    finally:
+        context.close()
+    assert set(parts) == set(expected)
+    for name, box in expected.items():   # same place, within the thinning's tolerance (m)
+        assert np.allclose(parts[name], box, atol=1.5e-4), name
+    assert embedded < len(glb) * 4 / 3   # the page embeds less than the file's base64

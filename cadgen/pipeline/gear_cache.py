@@ -128,3 +128,35 @@ def remember_cutting_outlines(train, chord_tolerance: float) -> int:
             profile.derived(("cutting outline", tolerance), lambda cut=cut: cut)
             found += 1
     return found
+
+
+def view_glb(glb: bytes, cache) -> bytes | None:
+    """The report's lighter copy of ``solids/assembly.glb`` (:func:`cadgen.report.view_glb.
+    lighter_glb`), from the cache a build's ``cache`` argument asks for, or made and stored
+    there: thinning the paper design's assembly takes about a second, and a design built
+    again (unchanged) has the same GLB. Keyed on the file's bytes and the thinning's source.
+    None when the copy cannot be made (the page then embeds the file, saying why).
+    """
+    import hashlib
+    import importlib.resources
+
+    from cadgen.report.view_glb import lighter_glb
+
+    store, key = open_cache(cache), None
+    if store is not None:
+        digest = hashlib.sha256(b"cadgen report view glb\0")
+        folder = importlib.resources.files("cadgen.report")
+        for source in ("view_glb.py", "decimate.py"):
+            digest.update(folder.joinpath(source).read_bytes())
+        digest.update(glb)
+        key = digest.hexdigest()
+        stored = store.get(key)
+        if isinstance(stored, bytes):
+            return stored
+    try:
+        light = lighter_glb(glb)
+    except (ValueError, KeyError, IndexError, TypeError):
+        return None
+    if store is not None:
+        store.put(key, light)
+    return light

@@ -27,6 +27,8 @@ import numpy as np
 
 from kinematics.planar import perp as _perp, unit as _unit
 
+from cadgen.report.html_tables import _section
+
 __all__ = ["POSES", "animation_data", "planting_animation", "pricking_animation",
            "animation_section", "placed"]
 
@@ -248,8 +250,7 @@ def animation_section(data: dict | None) -> str:
                      f'x1="1" y1="5" x2="25" y2="5"/></svg>{html.escape(text)}</li>'
                      for cls, text in data.get("legend", []))
     view = " ".join(str(v) for v in data["view"])
-    return (
-        '<section id="animation"><h2>Animation through one carrier turn</h2>'
+    return _section("animation", "Animation through one carrier turn", (
         f'<p class="note">{len(data["angles"])} poses from the kinematic model, uniform in '
         f'carrier angle ({data["seconds"]:g} s a turn); the trail is the tip\'s path since the '
         "start of the turn. Play, pause, or drag the slider to a pose.</p>"
@@ -262,4 +263,4 @@ def animation_section(data: dict | None) -> str:
         f'<span class="anim-angle">{html.escape(data["angle_label"])}: 0 deg</span></div>'
         f'<ul class="anim-legend">{legend}</ul>'
         f'<script type="application/json" class="anim-data">{payload}</script></div>'
-        f"<script>{_script()}</script></section>")
+        f"<script>{_script()}</script>"))

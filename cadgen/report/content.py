@@ -11,7 +11,7 @@ import numpy as np
 
 __all__ = ["input_hash", "report_dict", "assemble_report", "failures", "check_warnings",
            "warning_count", "verdict_text", "machine_section", "PREDICTED_FINDINGS",
-           "FAILING_GEAR_PROBLEMS", "FAILING_RIM_PROBLEMS"]
+           "FAILING_GEAR_PROBLEMS", "FAILING_RIM_PROBLEMS", "round_part_volume_error"]
 
 #: Pricking findings that predict what the cutting check measures (the pitch curve bends
 #: tighter than a rack cuts without undercut): a warning, never a failure by themselves; the cut
@@ -344,6 +344,14 @@ def _searches_achieved(searches: dict) -> str:
     return "minimum searches " + "; ".join(parts)
 
 
+def round_part_volume_error(segments: int) -> float:
+    """The relative volume a round part loses as the inscribed polygon of ``segments`` sides:
+    ``1 - sin(a) / a`` with ``a = 2 pi / segments`` (the report page rounds volumes and
+    masses to it)."""
+    angle = 2 * math.pi / segments
+    return 1 - math.sin(angle) / angle
+
+
 def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
     """What each resolution knob of this build buys, with the basis of the figure.
 
@@ -423,9 +431,8 @@ def accuracy_achieved(params, report: dict, values: dict, ok: set) -> list:
                               "smallest radius of the contour"})
     if "parts" in ok:
         n = params.solids.segments_per_circle
-        angle = 2 * math.pi / n
         rows.append({"knob": "solids.segments_per_circle", "value": n,
-                     "achieved": f"round parts {1 - math.sin(angle) / angle:.1e} short in "
+                     "achieved": f"round parts {round_part_volume_error(n):.1e} short in "
                                  f"volume; housings at most {1 / math.cos(math.pi / n) - 1:.1e} "
                                  "of their radius too large (they always enclose)",
                      "basis": "closed form of the inscribed and circumscribed n-gons"})

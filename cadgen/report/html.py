@@ -1,18 +1,27 @@
 """A design's report as one self-contained HTML page: tables and plots for a person.
 
-The page embeds every figure as a ``data:`` URI and carries its own CSS, so it
-opens anywhere (an e-mail attachment, an offline laptop) and references nothing
+The page embeds every figure as a ``data:`` URI and carries its own CSS and scripts, so
+it opens anywhere (an e-mail attachment, an offline laptop) and references nothing
 outside itself: no scripts, fonts, style sheets or images to fetch. It is a pure
 function of the report and the figures (no dates, no dictionary-order surprises
 in the figure gallery), so the same design gives the same bytes.
 
 Sections that a report lacks are left out, so reports of either mechanism kind,
 and reports with or without gears, cam, solids, sweep or stage statuses, render.
+Each section folds by its heading (``<details>``); reference sections (bill of
+materials, stages, accuracy, parameters) start folded unless they hold a failure.
+A table of contents beside the page (a bar over it on a narrow window) links every
+section; a small inline script (``toc.js``) marks the section in view, opens a folded
+section its link leads to and folds or unfolds them all. Without scripts the page reads
+the same: plain links, native folding. Numbers follow one precision rule
+(:mod:`cadgen.report.html_tables`); report.json keeps every digit.
 
 This module assembles the page: its verdict (the checks, the header), the figure
-gallery and the skeleton. The sections live in :mod:`cadgen.report.html_sections`,
-the table and number helpers in :mod:`cadgen.report.html_tables`, and the skeleton
-and style sheet are package data beside this module (``page.html``, ``report.css``).
+gallery, the contents and the skeleton. The sections live in
+:mod:`cadgen.report.html_sections` and :mod:`cadgen.report.html_machine`, the table and
+number helpers in :mod:`cadgen.report.html_tables`, and the skeleton, style sheet and
+contents script are package data beside this module (``page.html``, ``report.css``,
+``toc.js``).
 """
 
 from __future__ import annotations
@@ -26,6 +35,7 @@ import string
 import struct
 from pathlib import Path
 
+from cadgen.report.gear_verdict import gear_verdict
 from cadgen.report.html_sections import (_accuracy_section, _cam_section, _gears_section,
                                          _metrics_section, _parameters_section,
                                          _planting_motion_section, _pricking_section,
@@ -34,9 +44,9 @@ from cadgen.report.html_sections import (_accuracy_section, _cam_section, _gears
 from cadgen.report.html_machine import bom_section_html as _bom_section_html
 from cadgen.report.html_machine import machine_checks
 from cadgen.report.html_machine import machine_section_html as _machine_section_html
-from cadgen.report.html_tables import (_badge, _degrees_ranges, _e, _number, _pass_badge,
-                                       _plural, _problem_list, _quantity, _row, _section, _table,
-                                       _value_html)
+from cadgen.report.html_tables import (FAILING_MARKS, _badge, _degrees_ranges, _e, _number,
+                                       _pass_badge, _plural, _problem_list, _prose, _quantity,
+                                       _row, _section, _table, _value_html)
 
 __all__ = ["render_html", "write_html", "load_figures", "figure_caption", "overall_checks"]
 
@@ -53,12 +63,13 @@ _FIGURE_GROUPS = (
 
 
 @functools.cache
-def _page_resources() -> tuple[string.Template, str]:
-    """The page skeleton (``page.html``, ``$name`` placeholders) and its style sheet
-    (``report.css``), package data next to this module."""
+def _page_resources() -> tuple[string.Template, str, str]:
+    """The page skeleton (``page.html``, ``$name`` placeholders), its style sheet
+    (``report.css``) and the contents' script (``toc.js``), package data next to this module."""
     folder = importlib.resources.files("cadgen.report")
     return (string.Template(folder.joinpath("page.html").read_text(encoding="utf-8")),
-            folder.joinpath("report.css").read_text(encoding="utf-8"))
+            folder.joinpath("report.css").read_text(encoding="utf-8"),
+            folder.joinpath("toc.js").read_text(encoding="utf-8"))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -111,11 +122,8 @@ def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
     train = report.get("gear_train")
     if train is not None:
         failures = train.get("failures", [])
-        checks.append(("gears cut", not failures,
-                       f"{len(failures)} could not be cut: "
-                       + ", ".join(f["message"].split(" gear cannot")[0].removeprefix("the ")
-                                   for f in failures) if failures else
-                       _plural(len(train.get("gears", [])), "gear") + " cut"))
+        verdict = gear_verdict(report)   # the gears section and the terminal say the same
+        checks.append(("gears cut", verdict.passed and not failures, verdict.statement()))
         covered += [f"[{f['code']}]" for f in failures]
         gears = train.get("gears", [])
         bad = False
@@ -179,7 +187,7 @@ def _failure_list(failures, shown: int = 3) -> str:
     """The report's own reasons for not passing: the first few, the rest folded away."""
     if not failures:
         return ""
-    items = [f"<li>{_badge('fail')} {_e(text)}</li>" for text in failures]
+    items = [f"<li>{_badge('fail')} {_e(_prose(text))}</li>" for text in failures]
     rest = items[shown:]
     more = (f"<details><summary>{len(rest)} more</summary>"
             f'<ul class="issues">{"".join(rest)}</ul></details>' if rest else "")
@@ -254,8 +262,9 @@ def _header(report: dict) -> str:
     rows = "".join(f"<tr><td>{_e(k)}</td><td>{v}</td></tr>" for k, v in cells.items())
     rows += (f'<tr><td>input SHA-256</td><td class="hash">'
              f'{_e(report.get("input_sha256", "—"))}</td></tr>')
-    check_rows = [[_e(name), _pass_badge(ok), _e(detail)] for name, ok, detail in checks]
-    return (f"<header><h1>{_e(report.get('design', 'design'))}</h1>"
+    check_rows = [[_e(_prose(name)), _pass_badge(ok), _e(_prose(detail))]
+                  for name, ok, detail in checks]
+    return (f'<header><h1 id="verdict">{_e(report.get("design", "design"))}</h1>'
             f'<p class="sub">{_e(facts["mechanism"])} design report</p>'
             f"<p>{verdict}</p>"
             + _row(_table(["check", "result", "detail"], check_rows,
@@ -380,7 +389,7 @@ def _figures_section(figures: dict) -> str:
         title = _FIGURE_GROUPS[index][0] if index < len(_FIGURE_GROUPS) else "Other figures"
         items = "".join(_figure_html(name, figures[name]) for name in groups[index])
         parts.append(f'<h3>{_e(title)}</h3><div class="gallery">{items}</div>')
-    return _section("figures", "Figures", "".join(parts))
+    return _section("figures", "Figures", "".join(parts), gist=_plural(len(figures), "figure"))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -388,7 +397,8 @@ def _figures_section(figures: dict) -> str:
 
 
 def render_html(report: dict, figures: dict[str, bytes] | None = None, *,
-                animation: dict | None = None, assembly_glb: bytes | None = None) -> str:
+                animation: dict | None = None, assembly_glb: bytes | None = None,
+                assembly_view: bytes | None = None) -> str:
     """The report and its figures as one self-contained HTML page.
 
     Parameters
@@ -402,14 +412,18 @@ def render_html(report: dict, figures: dict[str, bytes] | None = None, *,
         grouped by what they show.
     animation, assembly_glb : optional
         The mechanism's poses (:func:`cadgen.report.animation.animation_data`) and
-        ``solids/assembly.glb``: an animation and a 3D view, each with its inline
-        script (:mod:`cadgen.report.viewer`); without them the page has no scripts.
+        ``solids/assembly.glb``: an animation and a 3D view (of a lighter copy of the
+        GLB, :mod:`cadgen.report.view_glb`), each with its inline script
+        (:mod:`cadgen.report.viewer`).
+    assembly_view : bytes, optional
+        The lighter copy of ``assembly_glb``, made already (a build keeps it in its cache).
 
     Returns
     -------
     str
-        The page: inline CSS, no scripts, no external references; the same input
-        gives the same string.
+        The page: inline CSS, the contents' script (and those of the animation and
+        the 3D view when given), no external references; the same input gives the
+        same string.
 
     Raises
     ------
@@ -431,18 +445,40 @@ def render_html(report: dict, figures: dict[str, bytes] | None = None, *,
                      _planting_motion_section(report)]
     from cadgen.report.viewer import interactive_sections
 
-    sections = [*mechanism, *interactive_sections(animation, assembly_glb),
+    sections = [*mechanism, *interactive_sections(animation, assembly_glb, assembly_view),
                 _gears_section(report), _cam_section(report),
                 _machine_section_html(report), _solids_section(report), _bom_section_html(report),
                 _figures_section(figures), _stages_section(report),
                 _accuracy_section(report), _parameters_section(report)]
     sections = [s for s in sections if s]
-    titles = re.findall(r'<section id="([^"]+)"><h2>([^<]+)</h2>', "".join(sections))
-    nav = "<nav>" + "".join(f'<a href="#{a}">{t}</a>' for a, t in titles) + "</nav>"
+    header = _header(report)
     title = _e(f"{report.get('design', 'design')}: cadgen report")
-    page, css = _page_resources()
-    return page.substitute(title=title, css=css, header=_header(report), nav=nav,
-                           sections="\n".join(sections))
+    page, css, script = _page_resources()
+    return page.substitute(title=title, css=css, header=header,
+                           nav=_contents(report, header, sections), sections="\n".join(sections),
+                           script=script)
+
+
+#: A section's heading as :func:`cadgen.report.html_tables._section` writes it.
+_HEADING = re.compile(r'<section id="([^"]+)"><details class="fold"[^>]*><summary><h2>([^<]+)</h2>')
+def _contents(report: dict, header: str, sections: list[str]) -> str:
+    """The table of contents: a link per section (the verdict first), a mark on those that
+    hold a failing row, and the fold controls (shown by the page's script; without it every
+    section still folds by its own heading)."""
+    entries = [("verdict", "Verdict and checks", any(f in header for f in FAILING_MARKS))]
+    for html_text in sections:
+        match = _HEADING.match(html_text)
+        if match:
+            entries.append((match[1], match[2], any(f in html_text for f in FAILING_MARKS)))
+    items = "".join(
+        f'<li><a href="#{anchor}"' + (' class="has-fail" title="holds a failing check"'
+                                      if failing else "") + f">{text}</a></li>"
+        for anchor, text, failing in entries)
+    name = _e(report.get("design", "design"))
+    return (f'<nav class="toc" aria-label="Contents"><p class="toc-title">'
+            f'<a href="#verdict">{name}</a></p><ol>{items}</ol>'
+            '<p class="toc-fold" hidden><button type="button" data-fold="open">Expand all'
+            '</button><button type="button" data-fold="close">Collapse all</button></p></nav>')
 
 
 def write_html(report: dict, figures: dict[str, bytes] | None,

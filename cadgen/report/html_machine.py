@@ -89,7 +89,8 @@ def machine_section_html(report: dict) -> str:
                      _pass_badge(s.get("strength_passed", True))])
     body.append("<h3>Shafts</h3>" + _table(
         ["shaft", "housing", "diameter (mm)", "required (mm)", "torque (N·m)", "length (mm)",
-         "hubs (key, flank pressure)", "strength"], rows, numeric=(2, 3, 4, 5)))
+         "hubs (key, flank pressure)", "strength"], rows, numeric=(2, 3, 4, 5),
+        empty="no shafts sized"))
     rows, classes = [], []
     for b, side in _sides(machine.get("bearings", []), lambda r: (r["shaft"], r["wall"])):
         rows.append([_e(f"{b['shaft']} {b['wall']}{side}"),
@@ -98,11 +99,12 @@ def machine_section_html(report: dict) -> str:
                         f"{_number(b['B_mm'], trim=True)}"),
                      _e(_number(b["C_kn"], trim=True)), _e(_number(b["seat_diameter_mm"], 4)),
                      _e(_number(b["load_n"], 0)), _e(_number(b["speed_rpm"], 1)),
-                     _e(_number(b["l10_h"], 0)), _pass_badge(b.get("passed", True))])
+                     _e(_number(b["l10_h"], significant=3)), _pass_badge(b.get("passed", True))])
         classes.append("" if b.get("passed", True) else "fail")
     body.append("<h3>Bearings (ISO 281 basic rating life L10)</h3>" + _table(
         ["shaft, wall", "bearing", "d x D x B (mm)", "C (kN)", "seat (mm)", "load (N)",
-         "speed (r/min)", "L10 (h)", "life"], rows, numeric=(3, 4, 5, 6, 7), row_classes=classes))
+         "speed (r/min)", "L10 (h)", "life"], rows, numeric=(3, 4, 5, 6, 7), row_classes=classes,
+        empty="no bearings chosen"))
     rims = machine.get("hubs", [])
     if rims:
         rows = [[_e(r["gear"]), _e(_number(r["rim_mm"])), _e(_number(r["limit_mm"])),
@@ -133,8 +135,9 @@ def bom_section_html(report: dict) -> str:
               _e(r["file"] or "—")] for r in rows]
     made = sum(r["quantity"] for r in rows if r["source"] == "make")
     bought = sum(r["quantity"] for r in rows if r["source"] == "buy")
-    return _section("bom", "Bill of materials", (
-        f"<p>{made} made parts and {bought} bought parts; the same rows are in "
-        f"<code>bom.csv</code></p>"
-        + _table(["item", "make/buy", "part", "description", "material", "process", "quantity",
-                  "mass each (kg)", "file"], table, numeric=(0, 6, 7))))
+    body = (f"<p>{made} made parts and {bought} bought parts; the same rows are in "
+            f"<code>bom.csv</code></p>"
+            + _table(["item", "make/buy", "part", "description", "material", "process",
+                      "quantity", "mass each (kg)", "file"], table, numeric=(0, 6, 7)))
+    return _section("bom", "Bill of materials", body, folded=True,
+                    gist=f"{made} made and {bought} bought parts")

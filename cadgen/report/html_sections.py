@@ -8,9 +8,10 @@ render. :func:`cadgen.report.html.render_html` puts them in page order.
 
 from __future__ import annotations
 
-from cadgen.report.html_tables import (_badge, _degrees_ranges, _e, _key_values, _number,
-                                       _pass_badge, _point, _problem_list, _quantity, _row,
-                                       _scientific, _section, _split_unit, _table)
+from cadgen.report.html_tables import (MAX_SIGNIFICANT, _badge, _degrees_ranges, _e,
+                                       _key_values, _number, _pass_badge, _plural, _point,
+                                       _problem_list, _prose, _quantity, _row, _scientific,
+                                       _section, _split_unit, _table, _to_accuracy, _value_html)
 
 __all__ = ["_metrics_section", "_planting_motion_section", "_pricking_section", "_sweep_section",
            "_gears_section", "_cam_section", "_solids_section", "_stages_section",
@@ -28,6 +29,8 @@ def _sweep_name(key: str, sweep: dict) -> str:
 
 def _metrics_section(report: dict) -> str:
     metrics = report.get("metrics", [])
+    if not metrics:
+        return ""
     # A clearance the solids' sweep measured keeps the kinematic estimate beside it.
     estimates = any("kinematic_estimate" in m for m in metrics)
     rows, classes = [], []
@@ -48,7 +51,9 @@ def _metrics_section(report: dict) -> str:
     headers = ["metric", "plant spacing", "value", "target", "result"]
     body = _table(headers + ["kinematic estimate"] * estimates, rows, numeric=(1, 2, 5),
                   row_classes=classes)
-    return _section("metrics", "Design metrics against targets", body)
+    met = sum(1 for m in metrics if m["passed"])
+    return _section("metrics", "Design metrics against targets", body,
+                    gist=f"{met} of {len(metrics)} met")
 
 
 def _planting_motion_section(report: dict) -> str:
@@ -224,6 +229,9 @@ def _gears_section(report: dict) -> str:
     train = report.get("gear_train")
     if train is None:
         return ""
+    from cadgen.report.gear_verdict import gear_verdict
+
+    verdict = gear_verdict(report)
     rows, problems = [], []
     for g in train.get("gears", []):
         cutter = g["cutter"] + (f" (z = {g['shaper_teeth']})" if g.get("shaper_teeth") else "")
@@ -235,11 +243,22 @@ def _gears_section(report: dict) -> str:
                      _e(_number(g["tip_thickness_min_mm"])),
                      _badge("warn") + " " + _e(codes) if codes else "—"])
         problems += g.get("problems", [])
-    body = [_table(["gear", "stage", "teeth", "module (mm)", "cutter", "convex", "undercut teeth",
-                    "pointed teeth", "min root thickness (mm)", "min tip thickness (mm)",
-                    "problems"], rows, numeric=(2, 3, 6, 7, 8, 9))
-            if rows else '<p class="note">no gears were cut</p>']
+    # the one statement of the checks row and the terminal, then the gears cut (if any)
+    body = [f"<p>{_pass_badge(verdict.passed)} {_e(verdict.statement())}</p>"]
+    if rows:
+        body.append(_table(["gear", "stage", "teeth", "module (mm)", "cutter", "convex",
+                            "undercut teeth", "pointed teeth", "min root thickness (mm)",
+                            "min tip thickness (mm)", "problems"], rows,
+                           numeric=(2, 3, 6, 7, 8, 9)))
     body.append(_problem_list(problems, "warn"))
+    not_cut = ([[_e(gear), _e(pair), _badge("fail") + " " + _e(f"cannot be cut: {reason}")]
+                for gear, pair, reason in verdict.not_cuttable]
+               + [[_e(gear), _e(pair), _e(f"not cut: its mate {mate} cannot be cut")]
+                  for gear, pair, mate in verdict.not_cut_with])
+    if not_cut:
+        body.append(f"<h3>Gears not cut ({len(not_cut)} of {verdict.total})</h3>"
+                    + _table(["gear", "pair", "why"], not_cut)
+                    + _problem_list(train.get("failures", [])))
     mesh_rows, classes = [], []
     for m in train.get("meshes", []):
         relief = m.get("tip_relief")
@@ -259,10 +278,7 @@ def _gears_section(report: dict) -> str:
              "largest overlap (mm²)", "backlash (deg)", "transmission error p-p (deg)",
              "tip relief"],
             mesh_rows, numeric=(2, 3, 4, 5, 6), row_classes=classes))
-    failures = train.get("failures", [])
-    if failures:
-        body.append(f"<h3>Gears not cut ({len(failures)})</h3>" + _problem_list(failures))
-    return _section("gears", "Gears", "".join(body))
+    return _section("gears", "Gears", "".join(body), gist=verdict.statement())
 
 
 def _cam_section(report: dict) -> str:
@@ -281,8 +297,11 @@ def _solids_section(report: dict) -> str:
     solids = report.get("solids")
     if solids is None:
         return ""
+    # volume and mass no finer than the polygonal round parts allow (accuracy_achieved)
+    error = _volume_error(report)
     rows = [[_e(p["part"]), _e(p["kind"]), _e(p.get("material", "—")), _e(str(p["instances"])),
-             _e(_number(p["volume_mm3"], 0)), _e(_number(p["mass_kg"])),
+             _e(_to_accuracy(p["volume_mm3"], _times(error, p["volume_mm3"]), "mm³")),
+             _e(_to_accuracy(p["mass_kg"], _times(error, p["mass_kg"]), "kg")),
              _e(_point(p["centre_of_mass_mm"], 2)), _e(str(p.get("triangles", "—"))),
              _pass_badge(p.get("watertight", True))]
             for p in solids.get("parts", [])]
@@ -296,7 +315,7 @@ def _solids_section(report: dict) -> str:
             f'{_e(_number(assembly.get("carrier_angle_deg"), trim=True))} deg</p>',
             _table(["part", "kind", "material", "instances", "volume (mm³)", "mass each (kg)",
                     "centre of mass (mm)", "triangles", "watertight"], rows,
-                   numeric=(3, 4, 5, 7))]
+                   numeric=(3, 4, 5, 7), empty="no parts")]
     enclosure, classes = [], []
     for r in solids.get("enclosure", []):
         ok = r.get("gears_enclosed", True) and r.get("axial_fit", True)
@@ -321,7 +340,25 @@ def _solids_section(report: dict) -> str:
              for p in too_big], numeric=(2,)))
     if solids.get("frames"):
         body.append(f'<p class="note">{_e(solids["frames"])}</p>')
-    return _section("solids", "Solids", "".join(body))
+    parts = solids.get("parts", [])
+    return _section("solids", "Solids", "".join(body),
+                    gist=f"{_plural(len(parts), 'part')}, total mass "
+                         f"{_quantity(solids.get('total_mass_kg'), 'kg')}")
+
+
+def _volume_error(report: dict) -> float | None:
+    """The relative volume error the report states for its round parts (the polygon of
+    ``solids.segments_per_circle`` sides, ``accuracy_achieved``), or None."""
+    from cadgen.report.content import round_part_volume_error
+
+    for row in report.get("accuracy_achieved") or []:
+        if row.get("knob") == "solids.segments_per_circle" and isinstance(row.get("value"), int):
+            return round_part_volume_error(row["value"])
+    return None
+
+
+def _times(error, value):
+    return None if error is None or not isinstance(value, (int, float)) else error * abs(value)
 
 
 def _stages_section(report: dict) -> str:
@@ -345,7 +382,11 @@ def _stages_section(report: dict) -> str:
     rows.append(["<b>total</b>", f"<b>{_e(_number(total))}</b>"] + ["", ""][: 2 * with_status])
     classes.append("")
     headers = ["stage", "seconds"] + (["status", "message"] if with_status else [])
-    return _section("stages", "Stages", _table(headers, rows, numeric=(1,), row_classes=classes))
+    failed = sum(1 for s in stages if s.get("status", "ok") != "ok")
+    return _section("stages", "Stages", _table(headers, rows, numeric=(1,), row_classes=classes),
+                    folded=not failed,
+                    gist=f"{_plural(len(stages), 'stage')}"
+                    + (f", {failed} not ok" if failed else "") + f", {_number(total, 1)} s")
 
 
 def _searches_table(searches: dict) -> str:
@@ -358,12 +399,13 @@ def _searches_table(searches: dict) -> str:
             label += " (a maximum: its bound is an upper one)"
         elif name in ("arm_distance", "ground_clearance"):
             label += " (kinematic estimate)"
-        rows.append([_e(label), _e(_number(value, 9)), _e(_number(bound, 9)),
+        rows.append([_e(label), _e(_number(value)), _e(_number(bound)),
                      "yes" if search.get("certified") else _badge("warn") + " no",
                      _e(_scientific(search.get("gap"))), _e(_scientific(search.get("atol"))),
                      "yes" if search.get("budget_spent") else "no",
                      _e(_number(search.get("refined_intervals"))),
                      _e(_number(search.get("evaluations")))])
+    # value and bound to the page's 0.001 mm: how far apart they are is the gap's column
     return _table(["search", "value (mm)", "certified bound (mm)", "certified", "gap", "atol",
                    "budget spent", "refined intervals", "evaluations"], rows,
                   numeric=(1, 2, 4, 5, 7, 8))
@@ -379,8 +421,9 @@ def _accuracy_section(report: dict) -> str:
         return ""
     body = []
     if achieved:
-        rows = [[f"<code>{_e(r.get('knob', ''))}</code>", _e(str(r.get("value", ""))),
-                 _e(r.get("achieved", "")), _e(r.get("basis", ""))] for r in achieved]
+        rows = [[f"<code>{_e(r.get('knob', ''))}</code>", _value_html(r.get("value", "")),
+                 _e(_prose(r.get("achieved", ""))), _e(_prose(r.get("basis", "")))]
+                for r in achieved]
         body.append("<h3>What each resolution knob buys</h3>"
                     + _table(["knob", "value", "achieved", "basis"], rows, numeric=(1,)))
     if verification:
@@ -388,17 +431,20 @@ def _accuracy_section(report: dict) -> str:
                     + _key_values(verification))
     if accuracy:
         searches = accuracy.pop("minimum_searches", None)
-        # More digits than elsewhere: here the point is how far apart value and bound are.
-        body.append("<h3>Metrics: closure and searches</h3>" + _key_values(accuracy, digits=9))
+        body.append("<h3>Metrics: closure and searches</h3>" + _key_values(accuracy))
         if searches:
             body.append("<h3>Certified minimum searches of the metrics (kinematic model)</h3>"
                         + _searches_table(searches))
-    return _section("accuracy", "Accuracy achieved", "".join(body))
+    return _section("accuracy", "Accuracy achieved", "".join(body), folded=True,
+                    gist=f"what {_plural(len(achieved), 'resolution knob')} bought"
+                    if achieved else "")
 
 
 def _parameters_section(report: dict) -> str:
     if not report.get("parameters"):
         return ""
+    # the values as written (to 6 significant digits): inputs, not results
     return _section("parameters", "Input parameters",
-                    f"<details><summary>show the validated parameters</summary>"
-                    f"{_key_values(report['parameters'])}</details>")
+                    '<p class="note">The validated parameters, as the build read them.</p>'
+                    + _key_values(report["parameters"], significant=MAX_SIGNIFICANT),
+                    folded=True, gist="the validated parameter file")

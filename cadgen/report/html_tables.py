@@ -5,17 +5,42 @@ Shared by :mod:`cadgen.report.html` (the page and its verdict) and
 function returns HTML text; cells passed in are HTML already, anything else is
 escaped here. The names keep their leading underscore: they are the page's
 internals, not part of the report API.
+
+Numbers follow one rule (report.json keeps every digit; only the page rounds):
+integers as they are; lengths to 0.001 mm, angles to 0.01 deg, areas to 0.001 mm²,
+volumes to 1 mm³, masses to 0.001 kg, times to 0.001 s, speeds to 0.01 mm/s; ratios,
+coefficients and anything else to 4 significant digits; a value whose accuracy the
+report states (a round part's volume, ``accuracy_achieved``) to no finer digit than that
+accuracy; a value that rounds to 0 at its decimals (an error, a gap) to 3 significant
+digits; and no number to more than :data:`MAX_SIGNIFICANT` significant digits, free text
+(messages, accuracy statements) included (:func:`_prose`). Hashes are not numbers.
 """
 
 from __future__ import annotations
 
 import html
 import math
+import re
 
-__all__ = ["_e", "_number", "_quantity", "_split_unit", "_badge", "_pass_badge", "_scientific",
-           "_degrees_ranges", "_point", "_plural", "_row", "_table", "_is_number",
-           "_records_table", "_value_html", "_vector_items", "_key_values", "_problem_list",
-           "_section"]
+__all__ = ["MAX_SIGNIFICANT", "SIGNIFICANT_OTHERWISE", "FAILING_MARKS", "_e", "_number",
+           "_quantity", "_to_accuracy", "_prose", "_precision", "_split_unit", "_badge",
+           "_pass_badge", "_scientific", "_degrees_ranges", "_point", "_plural", "_row", "_table",
+           "_is_number", "_records_table", "_value_html", "_vector_items", "_key_values",
+           "_problem_list", "_section"]
+
+#: The page's precision rule (the HTML and the terminal round; report.json keeps every digit):
+#: no number shows more than this many significant digits ...
+MAX_SIGNIFICANT = 6
+#: ... lengths to 0.001 mm, angles to 0.01 deg, and so on by unit (decimals) ...
+_DECIMALS = {"mm": 3, "mm²": 3, "mm³": 0, "deg": 2, "mm/s": 2, "s": 3, "kg": 3}
+#: ... and other quantities (ratios, coefficients, rad, 1/mm, no unit) to 4 significant digits.
+SIGNIFICANT_OTHERWISE = 4
+#: A decimal number in text (not part of a word, a version or a hash).
+_NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
+_NUMBER_IN_TEXT = re.compile(rf"(?<![\w.]){_NUMBER}(?!\w|\.\d)")
+
+#: What marks a failing row or item in the page's HTML (a section holding one opens).
+FAILING_MARKS = ('class="fail"', 'class="badge fail"')
 
 # Suffixes of report keys that name a unit, longest first so "_mm_s" wins over "_s".
 _UNIT_SUFFIXES = (
@@ -34,8 +59,35 @@ def _e(value) -> str:
     return html.escape(str(value), quote=True)
 
 
-def _number(value, digits: int = 3, trim: bool = False) -> str:
-    """A number as text: ``digits`` decimals, or 3 significant digits when that would show 0."""
+def _significant(value: float, significant: int) -> str:
+    """``value`` to ``significant`` significant digits, without an exponent from 1e-4 up:
+    ``0.7608862`` -> ``0.7609``, ``21534745.3`` (3) -> ``21500000``, ``1e-13`` -> ``1e-13``."""
+    if value == 0:
+        return "0"
+    if abs(value) >= 10 ** significant:
+        exponent = math.floor(math.log10(abs(value)))
+        return str(int(round(value, significant - 1 - exponent)))
+    if abs(value) < 1e-4:
+        return f"{value:.{min(significant, 3)}g}"
+    return f"{value:.{significant}g}"
+
+
+def _significant_digits(text: str) -> int:
+    """Significant digits of a number as printed (an integer's trailing zeros are not)."""
+    mantissa = text.lstrip("+-").split("e")[0].split("E")[0]
+    if "." in mantissa:
+        return len(mantissa.replace(".", "").lstrip("0"))
+    return len(mantissa.lstrip("0").rstrip("0"))
+
+
+def _number(value, digits: int | None = 3, trim: bool = False,
+            significant: int | None = None) -> str:
+    """A number as text, to the precision the page's rule gives it.
+
+    Integers as they are, a float with ``digits`` decimals (3 significant digits when that
+    would show 0), or with ``significant`` significant digits instead when that is given;
+    never more than :data:`MAX_SIGNIFICANT` significant digits (report.json keeps them all).
+    """
     if value is None:
         return "—"
     if isinstance(value, bool):
@@ -48,17 +100,69 @@ def _number(value, digits: int = 3, trim: bool = False) -> str:
         return str(value)
     if value == 0:
         return "0"
+    if significant is not None or digits is None:
+        return _significant(value, min(significant or MAX_SIGNIFICANT, MAX_SIGNIFICANT))
     text = f"{value:.{digits}f}"
-    if float(text) == 0 or abs(value) >= 1e9:
+    if float(text) == 0:
         return f"{value:.3g}"
+    if _significant_digits(text) > MAX_SIGNIFICANT:
+        return _significant(value, MAX_SIGNIFICANT)
     if trim and "." in text:
         text = text.rstrip("0").rstrip(".")
     return text
 
 
-def _quantity(value, unit: str = "", digits: int = 3, trim: bool = False) -> str:
-    text = _number(value, digits, trim)
+def _precision(unit: str) -> dict:
+    """The page's rule for a quantity in ``unit``: decimals or significant digits."""
+    digits = _DECIMALS.get(unit)
+    return {"digits": digits} if digits is not None else {"significant": SIGNIFICANT_OTHERWISE}
+
+
+def _quantity(value, unit: str = "", digits: int | None = None, trim: bool = False) -> str:
+    """``value unit``, to ``digits`` decimals or, without them, to the rule for ``unit``."""
+    rule = {"digits": digits} if digits is not None else _precision(unit)
+    text = _number(value, trim=trim, **rule)
     return f"{text} {unit}" if unit and value is not None and not isinstance(value, bool) else text
+
+
+def _to_accuracy(value, error: float | None, unit: str = "") -> str:
+    """``value`` with no digit finer than its stated ``error`` allows (its last digit the one
+    of the error's leading digit), nor finer than the rule for ``unit``: ``191772.6`` with an
+    error of 136 -> ``191800``."""
+    if value is None or not isinstance(value, float) or not error or not math.isfinite(error) \
+            or not math.isfinite(value):
+        return _number(value, **_precision(unit))
+    decimals = -math.floor(math.log10(abs(error)))
+    rule = _precision(unit).get("digits")
+    if rule is not None:
+        decimals = min(decimals, rule)
+    if decimals >= 0:
+        return _number(value, decimals)
+    return _number(float(round(value, decimals)), 0)
+
+
+def _prose(text) -> str:
+    """Free text (a message, an accuracy statement) with its numbers held to the page's rule:
+    a number of more than :data:`MAX_SIGNIFICANT` significant digits is rounded to that, and
+    an interval of such numbers is rounded by the rule of the unit after it, or, when its
+    ends would then read the same, ``[57.848863, 57.848864] mm``, as its middle and half
+    width, ``57.849 ± 5.0e-07 mm``."""
+    def interval(match):
+        low, high, unit = float(match[1]), float(match[2]), match[3] or ""
+        if max(_significant_digits(match[1]), _significant_digits(match[2])) <= MAX_SIGNIFICANT:
+            return match[0]
+        rule = _precision(unit.strip()) if unit else {"significant": MAX_SIGNIFICANT}
+        ends = [_number(low, **rule), _number(high, **rule)]
+        if ends[0] != ends[1]:   # still two numbers at the page's precision: the interval
+            return f"[{ends[0]}, {ends[1]}]{unit}"
+        return f"{_number((low + high) / 2, **rule)} ± {(high - low) / 2:.1e}{unit}"
+
+    def number(match):
+        return (_significant(float(match[0]), MAX_SIGNIFICANT)
+                if _significant_digits(match[0]) > MAX_SIGNIFICANT else match[0])
+
+    text = re.sub(rf"\[({_NUMBER}), ({_NUMBER})\]( mm\b| deg\b)?", interval, str(text))
+    return _NUMBER_IN_TEXT.sub(number, text)
 
 
 def _split_unit(key: str) -> tuple[str, str]:
@@ -108,8 +212,13 @@ def _row(*blocks: str) -> str:
 # generic blocks
 
 
-def _table(headers, rows, numeric=(), row_classes=None) -> str:
-    """An HTML table; cells are HTML already, ``numeric`` column indices are right-aligned."""
+def _table(headers, rows, numeric=(), row_classes=None, empty: str = "none") -> str:
+    """An HTML table; cells are HTML already, ``numeric`` column indices are right-aligned.
+
+    No rows: no table (a header over nothing), but ``empty``, a statement, as a note.
+    """
+    if not rows:
+        return f'<p class="note">{_e(empty)}</p>'
     head = "".join(f"<th>{_e(h)}</th>" for h in headers)
     body = []
     for k, row in enumerate(rows):
@@ -126,12 +235,22 @@ def _is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+def _shown(value, unit: str = "", digits: int | None = None,
+           significant: int | None = None) -> str:
+    """A number of a generic table: ``significant`` digits when given (values as written, the
+    parameters), else ``digits`` decimals, else the rule for ``unit``; trailing zeros off."""
+    if significant is not None:
+        return _number(value, significant=significant)
+    rule = {"digits": digits} if digits is not None else _precision(unit)
+    return _number(value, trim=True, **rule)
+
+
 def _records_table(records: list, index: list | None = None, unit: str = "",
-                   digits: int = 3) -> str:
+                   digits: int | None = None, significant: int | None = None) -> str:
     """Dicts as the rows of one table (columns: the union of their keys, in order)."""
     keys = list(dict.fromkeys(k for r in records for k in r))
     headers = [_split_unit(k)[0] for k in keys]
-    rows = [[_value_html(r.get(k), _split_unit(k)[1] or unit, digits) for k in keys]
+    rows = [[_value_html(r.get(k), _split_unit(k)[1] or unit, digits, significant) for k in keys]
             for r in records]
     if index is not None:
         headers = ["", *headers]
@@ -139,42 +258,50 @@ def _records_table(records: list, index: list | None = None, unit: str = "",
     return _table(headers, rows)
 
 
-def _value_html(value, unit: str = "", digits: int = 3) -> str:
-    """Any JSON value as HTML: dicts and lists of dicts as nested tables, numbers with units."""
+def _value_html(value, unit: str = "", digits: int | None = None,
+                significant: int | None = None) -> str:
+    """Any JSON value as HTML: dicts and lists of dicts as nested tables, numbers with units
+    (to ``digits`` decimals or ``significant`` digits when given, else to the rule for
+    their unit)."""
     if isinstance(value, dict):
         if len(value) > 1 and all(isinstance(v, dict) and v for v in value.values()):
             # e.g. {"lowest_point": {"value": ..., "certified": ...}, ...}: one row each
             return _records_table(list(value.values()), [_split_unit(str(k))[0] for k in value],
-                                  unit, digits)
-        return _key_values(value, unit, digits)
+                                  unit, digits, significant)
+        return _key_values(value, unit, digits, significant)
     if isinstance(value, (list, tuple)):
         if not value:
             return "none"
         if all(isinstance(v, dict) for v in value):
-            return _records_table(list(value), None, unit, digits)
+            return _records_table(list(value), None, unit, digits, significant)
         if all(isinstance(v, (list, tuple)) for v in value):
-            return ", ".join(_value_html(v, unit, digits) for v in value)
-        text = ", ".join(_vector_items(value, digits))
+            return ", ".join(_value_html(v, unit, digits, significant) for v in value)
+        text = ", ".join(_vector_items(value, digits, unit, significant))
         return _e(f"({text}) {unit}".rstrip() if unit else f"({text})")
     if _is_number(value):
-        return _e(_quantity(value, unit, digits, trim=True))
-    return _e(_number(value))
+        text = _shown(value, unit, digits, significant)
+        return _e(f"{text} {unit}" if unit else text)
+    return _e(_prose(_number(value)))
 
 
-def _vector_items(values, digits: int = 3) -> list[str]:
+def _vector_items(values, digits: int | None = None, unit: str = "",
+                  significant: int | None = None) -> list[str]:
     """Items of a list as text; a number's round-off noise (1e-14 next to 140) reads as 0."""
     scale = max((abs(v) for v in values if _is_number(v)), default=0.0)
-    return [_number(0.0 if abs(v) < 1e-9 * scale else v, digits, trim=True) if _is_number(v)
-            else _number(v) for v in values]
+    return [_shown(0.0 if abs(v) < 1e-9 * scale else v, unit, digits, significant)
+            if _is_number(v) else _prose(_number(v)) for v in values]
 
 
-def _key_values(mapping: dict, unit: str = "", digits: int = 3) -> str:
+def _key_values(mapping: dict, unit: str = "", digits: int | None = None,
+                significant: int | None = None) -> str:
     """A two-column table of a dict; keys lose their unit suffix, values gain the unit."""
+    if not mapping:
+        return '<span class="note">none</span>'
     rows = []
     for key, value in mapping.items():
         label, own_unit = _split_unit(str(key))
         shown = f"{label} ({own_unit})" if own_unit and isinstance(value, dict) else label
-        cell = _value_html(value, own_unit or unit, digits)
+        cell = _value_html(value, own_unit or unit, digits, significant)
         rows.append(f"<tr><td>{_e(shown)}</td><td>{cell}</td></tr>")
     return f'<table class="kv"><tbody>{"".join(rows)}</tbody></table>'
 
@@ -188,9 +315,20 @@ def _problem_list(problems, state: str = "fail") -> str:
         where = p.get("path") or p.get("stage") or ""
         where = f" <code>{_e(where)}</code>" if where else ""
         items.append(f"<li>{_badge(state)} <code>[{_e(p.get('code', ''))}]</code>{where} "
-                     f"{_e(p.get('message', ''))}</li>")
+                     f"{_e(_prose(p.get('message', '')))}</li>")
     return f'<ul class="issues">{"".join(items)}</ul>'
 
 
-def _section(anchor: str, title: str, body: str) -> str:
-    return f'<section id="{anchor}"><h2>{_e(title)}</h2>{body}</section>'
+def _section(anchor: str, title: str, body: str, *, folded: bool = False,
+             gist: str = "") -> str:
+    """A major section of the page: its heading folds it (``<details>``, no script needed).
+
+    ``folded``: closed when the page opens (reference material the reader opens), unless
+    it holds a failing row or item; ``gist``: a few words beside the heading, seen while
+    the section is folded.
+    """
+    if folded and any(mark in body for mark in FAILING_MARKS):
+        folded = False
+    gist = f'<span class="gist">{_e(gist)}</span>' if gist else ""
+    return (f'<section id="{anchor}"><details class="fold"{"" if folded else " open"}>'
+            f"<summary><h2>{_e(title)}</h2>{gist}</summary>{body}</details></section>")

@@ -89,8 +89,8 @@ def pricking_summary(report: dict) -> str:
     lines = [f"design {report['design']} (pricking mechanism): {verdict_text(report)}; "
              f"{'verified' if report['verified'] else 'NOT VERIFIED'}, "
              f"{len(report['findings'])} finding{'s' if len(report['findings']) != 1 else ''}",
-             f"linkage: a = {n(link['centre_distance_a_mm'], '.4f')} mm, l = "
-             f"{n(link['tip_reach_l_mm'], '.4f')} mm, l1 = {n(link['rocker_l1_mm'], '.3f')} mm, "
+             f"linkage: a = {n(link['centre_distance_a_mm'], '.3f')} mm, l = "
+             f"{n(link['tip_reach_l_mm'], '.3f')} mm, l1 = {n(link['rocker_l1_mm'], '.3f')} mm, "
              f"l2 = {n(link['needle_l2_mm'], '.3f')} mm; carrier turns {link['carrier_sense']}",
              f"gears: w = {n(gears['split_exponent_w'], '.4f')}, scale {n(gears['scale'], '.5f')}, "
              f"teeth {' / '.join(str(t) for t in teeth)}, modules "

@@ -40,7 +40,7 @@ def summary_text(report: dict) -> str:
     if "sweep" in report:
         sections.append(format_clearances(report["sweep"]))
     if "gear_train" in report:
-        sections.append(format_gear_table(report["gear_train"]))
+        sections.append(format_gear_table(report["gear_train"], report))
     if "cam" in report:
         sections.append(format_cam(report["cam"]))
     if "solids" in report:
@@ -149,7 +149,7 @@ def format_metrics_table(report: dict) -> str:
         lines.append("catching-to-planting height: "
                      f"{_number(ev['catch_to_plant_height_mm'], '.3f')} mm")
     d = report["derived"]
-    lines.append(f"centre distance a = {_number(d['centre_distance_a_mm'], '.6f')} mm, "
+    lines.append(f"centre distance a = {_number(d['centre_distance_a_mm'], '.4f')} mm, "
                  f"module {_number(d['module_mm'], '.4f')} mm, ratio "
                  f"{_number(d['ratio_min'], '.4f')}..{_number(d['ratio_max'], '.4f')}")
     return "\n".join(lines)
@@ -237,22 +237,33 @@ def format_solids(solids: dict) -> str:
     return "\n".join(lines)
 
 
-def format_gear_table(gear_train: dict) -> str:
-    """Plain-text table of the generated gears and their meshes."""
+def format_gear_table(gear_train: dict, report: dict | None = None) -> str:
+    """The gear verdict in one line (as the report page words it), then a table of the gears
+    cut (none when none was), their meshes, and why any gear was not cut.
+
+    ``report``, the whole report, lets the verdict name the pairs' other gears (a pricking
+    report's pitch curves); without it the train's own entries are used.
+    """
+    from cadgen.report.gear_verdict import gear_verdict
+
+    verdict = gear_verdict(report if report is not None else {"gear_train": gear_train})
+    lines = [f"gears: {verdict.statement()}"]
     rows = [("gear", "teeth", "module", "cutter", "undercut teeth", "pointed", "problems")]
     for g in gear_train["gears"]:
         rows.append((g["gear"], str(g["teeth"]), _number(g["module_mm"], ".4f"), g["cutter"] +
                      (f" (z={g['shaper_teeth']})" if g.get("shaper_teeth") else ""),
                      str(len(g["undercut_teeth"])), str(len(g["pointed_teeth"])),
                      ", ".join(p["code"] for p in g["problems"]) or "-"))
-    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in rows]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    lines.append("")
+    if len(rows) > 1:   # a header over no rows says nothing the line above does not
+        widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+        table = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in rows]
+        table.insert(1, "  ".join("-" * w for w in widths))
+        lines += [""] + table
+    meshes = []
     for m in gear_train["meshes"]:
         relief = m.get("tip_relief")
         backlash = m.get("backlash_deg") or (None, None)
-        lines.append(
+        meshes.append(
             f"mesh {m['stage']}: {m['interference_poses']} interfering poses of {m['poses']} "
             f"(largest overlap {_number(m.get('overlap_area_max_mm2'), '.1e')} mm2), backlash "
             f"{_number(backlash[0], '.1e')}..{_number(backlash[1], '.1e')} deg, transmission "
@@ -261,5 +272,7 @@ def format_gear_table(gear_train: dict) -> str:
                f"{_number(relief['removed_area_mm2'], '.3f')} mm2, up to "
                f"{_number(relief['depth_mm'], '.3f')} mm deep" if relief else ""))
     for f in gear_train["failures"]:
-        lines.append(f"NOT CUT [{f['code']}] {f['message']}")
+        meshes.append(f"NOT CUT [{f['code']}] {f['message']}")
+    if meshes:
+        lines += [""] + meshes
     return "\n".join(lines)

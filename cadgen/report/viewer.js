@@ -5,7 +5,9 @@
   var root = document.getElementById("cadgen-viewer");
   if (!root) return;
   var message = root.querySelector(".viewer-message");
-  var state = window.cadgenViewer = {state: "loading", meshes: 0, renders: 0};
+  // what the view drew, for a reader's console and the tests: each part's name and its box
+  // in the scene (metres), as placed by the GLB's nodes
+  var state = window.cadgenViewer = {state: "loading", meshes: 0, renders: 0, parts: {}};
 
   function fail(kind, text) {
     state.state = kind;
@@ -70,6 +72,8 @@
       // drawn from both sides since a housing's cavity faces inwards
       if (node.material) node.material.side = T.DoubleSide;
       state.meshes += 1;
+      var box = new T.Box3().setFromObject(node, true);
+      state.parts[name] = box.min.toArray().concat(box.max.toArray());
       if (/-cover(-|$)/.test(name)) covers.push(node);
       if (!/^ground/.test(name)) fit.expandByObject(node);   // the soil slab is wide: not framed
     });
