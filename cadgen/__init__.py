@@ -46,6 +46,8 @@ _EXPORTS = {
     # evaluating a design (nothing written) and building it (files written)
     "evaluate": "cadgen.design",
     "build": "cadgen.pipeline.build",
+    "check_build": "cadgen.pipeline.plan",
+    "BuildPlan": "cadgen.pipeline.plan",
     "BuildResult": "cadgen.pipeline.build",
     "check_output_root": "cadgen.export.atomic",
     "run_analysis": "cadgen.pipeline.build",

@@ -70,26 +70,38 @@ def _steps(text: str) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from cadgen import MechanismError, ParameterError, load_params, stage_problems
+    """Each file's verdict is its build's: what ``cadgen build FILE`` (the file's own scene)
+    refuses is an error here (exit 2), a check of a stage the scene does not run a warning."""
+    from cadgen import MechanismError, ParameterError, check_build, load_params
 
     status = EXIT_OK
     for file in args.files:
         try:
-            warnings = stage_problems(load_params(file))
+            params = load_params(file)
         except ParameterError as exc:
             status = EXIT_PROBLEMS
-            for problem in exc.problems:   # a stage's check: an error only where it runs
+            # with errors in the file its scene is unknown: a stage's check is listed as a
+            # warning beside them (once the file loads, check_build decides)
+            for problem in exc.problems:
                 print(f"{file}: {'warning: ' if problem.stage else ''}{problem}")
+            continue
         except MechanismError as exc:
             # A check that could not finish (e.g. a convergence failure) is still a
             # verdict on this file, not a crash of the whole batch.
             status = EXIT_PROBLEMS
             print(f"{file}: {exc} [{type(exc).__name__}]")
-        else:
-            for problem in warnings:
-                print(f"{file}: warning: {problem}")
-            print(f"{file}: ok" + (f" ({len(warnings)} warning{'s' * (len(warnings) > 1)})"
-                                   if warnings else ""))
+            continue
+        try:
+            warnings = check_build(params).warnings
+        except ParameterError as exc:   # what its build refuses: errors, as build says them
+            status = EXIT_PROBLEMS
+            for problem in exc.problems:
+                print(f"{file}: {problem}")
+            continue
+        for problem in warnings:
+            print(f"{file}: warning: {problem}")
+        print(f"{file}: ok" + (f" ({len(warnings)} warning{'s' * (len(warnings) > 1)})"
+                               if warnings else ""))
     return status
 
 

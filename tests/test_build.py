@@ -15,7 +15,7 @@ from cadgen.params import load_params
 from cadgen.params.scene import EFFECTS
 from kinematics.errors import DesignError, Problem
 
-from helpers import REFERENCE, edited
+from helpers import REFERENCE, edited, with_keys
 
 KERNEL_A = REFERENCE.parent / "kernel-a.toml"
 
@@ -412,11 +412,21 @@ def test_a_build_that_runs_the_cam_refuses_the_design_and_writes_nothing(short_p
     assert not (out / "short-planter").exists()
 
 
-def test_validate_reports_a_cam_check_as_a_warning_with_its_stage(short_planter, capsys):
-    assert main(["validate", str(short_planter)]) == EXIT_OK
+def test_validate_says_what_the_files_own_scene_builds(short_planter, tmp_path, capsys):
+    # its scene runs the cam: validate refuses it as build does, with the same line
+    assert main(["validate", str(short_planter)]) == 2
+    validated = capsys.readouterr().out.splitlines()
+    assert main(["build", str(short_planter), "--output-dir", str(tmp_path / "out")]) == 2
+    assert validated == capsys.readouterr().err.splitlines()
+    assert len(validated) == 1 and "[push_rod_inverted] (stage cam)" in validated[0]
+    # a scene without the cam: a warning in both, with its stage
+    metrics_only = tmp_path / "metrics-only.toml"
+    metrics_only.write_text(with_keys(short_planter.read_text(encoding="utf-8"), "scene",
+                                      effects='["metrics"]'), encoding="utf-8")
+    assert main(["validate", str(metrics_only)]) == EXIT_OK
     lines = capsys.readouterr().out.splitlines()
-    assert any(line.startswith(f"{short_planter}: warning: cam.lever.roller_arm: ")
-               and line.endswith("[push_rod_inverted] (stage cam)") for line in lines), lines
+    assert lines == [f"{metrics_only}: warning: {validated[0].split(': ', 1)[1]}",
+                     f"{metrics_only}: ok (1 warning)"]
 
 
 def test_the_library_loads_such_a_design_for_a_metrics_only_evaluation():

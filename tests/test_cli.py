@@ -425,3 +425,39 @@ def test_a_reader_that_goes_away_is_a_quiet_141(monkeypatch, capsys):
     assert main(["validate", str(REFERENCE)]) == cadgen.cli.EXIT_BROKEN_PIPE == 141
     assert capsys.readouterr().err == ""
     assert redirected in ([], [1])   # stdout to /dev/null where it is a file (not here)
+
+
+PARAMS_DIR = REFERENCE.parent
+WRONG_KINDS = [  # (command line, the file's kind, the command the line must name)
+    (["batch", "--grid", PARAMS_DIR / "xin2024-planter.toml"], "parameter", "cadgen build FILE"),
+    (["optimize", PARAMS_DIR / "xin2024-planter.toml"], "parameter", "cadgen build FILE"),
+    (["optimize", PARAMS_DIR / "grids" / "l2-sweep.toml"], "grid", "cadgen batch --grid FILE"),
+    (["batch", "--grid", PARAMS_DIR / "studies" / "planter-margins.toml"], "study",
+     "cadgen optimize FILE"),
+    (["batch", PARAMS_DIR / "grids" / "l2-sweep.toml"], "grid", "cadgen batch --grid FILE"),
+    (["batch", PARAMS_DIR / "studies" / "planter-margins.toml"], "study",
+     "cadgen optimize FILE")]
+
+
+@pytest.mark.parametrize("argv, kind, command", WRONG_KINDS,
+                         ids=["grid<-params", "optimize<-params", "optimize<-grid",
+                              "grid<-study", "batch<-grid", "batch<-study"])
+def test_a_file_of_another_kind_names_the_command_that_reads_it(argv, kind, command, tmp_path,
+                                                                  capsys):
+    out = tmp_path / "out"
+    status = main([*map(str, argv), "--output-dir", str(out)])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and not out.exists()
+    # one line, not an "unknown key" per table of the file
+    assert len(lines) == 1, lines
+    assert f"this is a {kind} file" in lines[0] and f"run `{command}`" in lines[0]
+
+
+def test_a_batch_of_a_missing_file_exits_2_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "out"
+    status = main(["batch", str(tmp_path / "nosuch.toml"), str(REFERENCE), "--output-dir",
+                   str(out)])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and not out.exists()
+    assert lines == [f"{tmp_path / 'nosuch.toml'}: <file>: no such file: "
+                     f"{tmp_path / 'nosuch.toml'} [file_not_found]"]

@@ -163,6 +163,25 @@ def add_batch_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
     return parser
 
 
+def _unusable_files(files) -> list[str]:
+    """One line per FILE that is not there, or is plainly not a parameter file (a grid or a
+    study: the line names the command that reads it). A parameter file with problems is a
+    design that fails in the batch; these are mistakes of the command line."""
+    from pathlib import Path
+
+    from cadgen.params.side_files import read_toml_file, wrong_kind_of_file
+
+    lines = []
+    for file in files:
+        data, _, problems = read_toml_file(Path(file), "")
+        if data is None:
+            problems = [p for p in problems if p.code in ("file_not_found", "not_readable")]
+        else:
+            problems = wrong_kind_of_file(data, "parameter")
+        lines += [f"{file}: {problem}" for problem in problems]
+    return lines
+
+
 def main_batch(args: argparse.Namespace) -> int:
     """Run ``cadgen batch`` (``args`` from :func:`add_batch_arguments`): build every design,
     write the summary, print where it is.
@@ -175,6 +194,11 @@ def main_batch(args: argparse.Namespace) -> int:
         bad grid file, no designs, no Dask). Progress goes to stderr; the closing
         counts and the summary paths to stdout.
     """
+    missing = _unusable_files(args.files)
+    if missing:   # a command line that names no design to build: nothing runs or is written
+        for line in missing:
+            print(line, file=sys.stderr)
+        return EXIT_PROBLEMS
     jobs = file_jobs(args.files)
     for grid in args.grid:
         try:

@@ -29,7 +29,8 @@ from typing import Any
 from kinematics.errors import DesignError, Problem
 
 from cadgen.batch.summary import SUMMARY_CSV, SUMMARY_HTML
-from cadgen.params.side_files import assign_dotted as _assign, flatten_dotted, read_toml_file
+from cadgen.params.side_files import (assign_dotted as _assign, flatten_dotted, read_toml_file,
+                                      wrong_kind_of_file)
 from cadgen.params.side_files import is_number as _is_number, show as _show
 
 __all__ = ["DesignJob", "GridError", "file_jobs", "expand_grid", "guard_names"]
@@ -220,6 +221,9 @@ def expand_grid(grid_file: str | os.PathLike) -> list[DesignJob]:
     grid, _, problems = read_toml_file(grid_path, "")
     if grid is None:
         raise GridError(problems, source)
+    wrong = wrong_kind_of_file(grid, "grid")
+    if wrong:   # one line naming the command that reads it, not an unknown key per table
+        raise GridError(wrong, source)
     problems += [Problem(str(k), "unknown_key", f"unknown key '{k}' at the top level of the grid "
                          f"file; known keys: {', '.join(_GRID_KEYS)}")
                  for k in grid if k not in _GRID_KEYS]

@@ -44,7 +44,8 @@ from typing import Any
 from kinematics.errors import Problem
 
 from cadgen.params.loading import ParameterError
-from cadgen.params.side_files import assign_dotted as _assign, flatten_dotted, read_toml_file
+from cadgen.params.side_files import (assign_dotted as _assign, flatten_dotted, read_toml_file,
+                                      wrong_kind_of_file)
 from cadgen.params.side_files import is_number as _is_number, show as _show
 
 __all__ = ["Study", "StudyError", "load_study", "STUDY_KEYS", "DEFAULT_EVALUATIONS",
@@ -328,6 +329,9 @@ def load_study(path: str | os.PathLike) -> Study:
     data, text, problems = read_toml_file(study_path, "")
     if data is None:
         raise StudyError(problems, source)
+    wrong = wrong_kind_of_file(data, "study")
+    if wrong:   # one line naming the command that reads it, not an unknown key per table
+        raise StudyError(wrong, source)
     problems += [Problem(str(k), "unknown_key", f"unknown key '{k}' at the top level of the "
                          f"study; known keys: {', '.join(STUDY_KEYS)}")
                  for k in data if k not in STUDY_KEYS]

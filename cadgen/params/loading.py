@@ -39,6 +39,7 @@ from cadgen.params._problems import (
 )
 from cadgen.params.planting import PlantingParameters
 from cadgen.params.pricking import PrickingParameters
+from cadgen.params.side_files import wrong_kind_of_file
 
 __all__ = [
     "ParameterError",
@@ -164,7 +165,7 @@ def validate_data(
     if not isinstance(data, Mapping):
         problem = Problem("", "wrong_type", f"expected a table, not {_describe(data)}")
         raise ParameterError([problem], source)
-    problems = _too_long_integers(data) or _other_kind_of_file(data)
+    problems = _too_long_integers(data) or wrong_kind_of_file(data, "parameter")
     if problems:
         raise ParameterError(problems, source)
     params, problems = _structural(data)
@@ -177,28 +178,6 @@ def validate_data(
     if staged:
         params._stage_problems = tuple(staged)
     return params
-
-
-#: Files that sit beside the parameter files but are not ones: a top-level ``base`` with the
-#: table that says what they do, and the command that reads them.
-_OTHER_FILE_KINDS = (("free", "study file", "cadgen optimize FILE"),
-                     ("grid", "grid file", "cadgen batch --grid FILE"))
-
-
-def _other_kind_of_file(data: Mapping[str, Any]) -> list:
-    """One problem saying which command reads ``data``, when it is a study or grid file.
-
-    A user who runs ``cadgen build`` on ``params/studies/x.toml`` would otherwise read that
-    ``mechanism`` is missing, which is true and no help.
-    """
-    if "mechanism" in data or "base" not in data:
-        return []
-    for table, what, command in _OTHER_FILE_KINDS:
-        if isinstance(data.get(table), Mapping):
-            return [Problem("", "not_a_parameter_file",
-                            f"this is a {what} (a base design and [{table}]), not a parameter "
-                            f"file: run `{command}`")]
-    return []
 
 
 _TOML_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")

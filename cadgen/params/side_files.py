@@ -15,7 +15,43 @@ from typing import Any
 
 from kinematics.errors import Problem
 
-__all__ = ["read_toml_file", "show", "is_number", "flatten_dotted", "assign_dotted"]
+__all__ = ["read_toml_file", "show", "is_number", "flatten_dotted", "assign_dotted",
+           "FILE_KINDS", "kind_of_file", "wrong_kind_of_file"]
+
+#: The three kinds of file, how each is told (a top-level key or table) and the command that
+#: reads it: a parameter file has ``mechanism``; a grid and a study name a ``base`` design
+#: and hold ``[grid]`` or ``[free]``.
+FILE_KINDS = {"parameter": ("mechanism", "parameter file", "cadgen build FILE"),
+              "grid": ("grid", "grid file", "cadgen batch --grid FILE"),
+              "study": ("free", "study file", "cadgen optimize FILE")}
+
+
+def kind_of_file(data: Mapping[str, Any]) -> str | None:
+    """``"parameter"``, ``"grid"`` or ``"study"``: what ``data`` (a parsed TOML file) is by its
+    tables, or None when it is none of them plainly."""
+    if "mechanism" in data and "base" not in data:
+        return "parameter"
+    if "base" in data and "mechanism" not in data:
+        for kind in ("grid", "study"):
+            if isinstance(data.get(FILE_KINDS[kind][0]), Mapping):
+                return kind
+    return None
+
+
+def wrong_kind_of_file(data: Mapping[str, Any], expected: str) -> list[Problem]:
+    """One problem naming the command that reads ``data``, when it is plainly another kind of
+    file than ``expected`` (a parameter file given to ``cadgen batch --grid``, a study given
+    to ``cadgen build``); else none. A user would otherwise read one ``unknown key`` per
+    table, which is true and no help."""
+    kind = kind_of_file(data)
+    if kind is None or kind == expected:
+        return []
+    key, what, command = FILE_KINDS[kind]
+    wanted = FILE_KINDS[expected][1]
+    how = f"mechanism = {show(data['mechanism'])}" if kind == "parameter" else \
+        f"a base design and [{key}]"
+    return [Problem("", "not_a_" + FILE_KINDS[expected][1].replace(" ", "_"),
+                    f"this is a {what} ({how}), not a {wanted}: run `{command}`")]
 
 
 def read_toml_file(path: Path, where: str) -> tuple[dict | None, str, list[Problem]]:

@@ -52,8 +52,8 @@ import numpy as np
 from kinematics.errors import ConvergenceError, DesignError, MechanismError
 
 # the scene's planning, here too for the callers that import it from the build
-from cadgen.pipeline.plan import (EFFECT_STAGES, STAGE_NEEDS, STAGE_ORDER, plan, scene_plan,
-                                  stage_warnings)
+from cadgen.pipeline.plan import (EFFECT_STAGES, STAGE_NEEDS, STAGE_ORDER, check_build, plan,
+                                  scene_plan, stage_warnings)
 from cadgen.pipeline.progress import WRITE_STAGE
 
 __all__ = ["EFFECT_STAGES", "plan", "scene_plan", "stage_warnings", "BuildResult", "build",
@@ -366,8 +366,6 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
         no effect of the scene applies to the design (``scene.effects``,
         ``nothing_to_build``).
     """
-    from cadgen.params.scene import apply_preset
-
     if parallel is not None and not isinstance(parallel, bool):
         raise TypeError(f"parallel must be True, False or None, not {parallel!r}")
     if output_root is not None:
@@ -375,17 +373,13 @@ def build(params, output_root: Path | str | None = Path("outputs"), *, effects=N
 
         check_output_root(output_root, name=params.name)
 
-    scene = params.scene
-    preset = preset or scene.preset
-    params, knobs = apply_preset(params, preset)
-    effects = tuple(effects) if effects is not None else scene.effects
-    case = case or scene.case
-    stages, set_aside, warnings = scene_plan(params, effects, case)
-    run = _Build(params, stages, steps, progress)
-    run.warnings = warnings
-    run.effects, run.case, run.cache, run.parallel = effects, case, cache, parallel
-    run.preset = {"name": preset, "knobs": {path: {"value": value, "from": source}
-                                            for path, (value, source) in knobs.items()}}
+    checked = check_build(params, effects=effects, case=case, preset=preset)
+    params, set_aside = checked.params, checked.set_aside
+    run = _Build(params, checked.stages, steps, progress)
+    run.warnings = checked.warnings
+    run.effects, run.case, run.cache, run.parallel = checked.effects, checked.case, cache, parallel
+    run.preset = {"name": checked.preset, "knobs": {
+        path: {"value": value, "from": source} for path, (value, source) in checked.knobs.items()}}
     with _fewer_collections():
         run.run(STAGE_FUNCTIONS)
         from cadgen.report.content import assemble_report
@@ -441,10 +435,14 @@ def _write(run, final: Path) -> BuildResult:
                 from cadgen.pipeline.writers import animation_of
                 from cadgen.report.html import render_html
 
+                from cadgen.pipeline.gear_cache import view_glb
+
                 glb = staging / "solids" / "assembly.glb"   # the 3D view shows the file written
+                glb = glb.read_bytes() if glb.is_file() else None
                 (staging / "report.html").write_text(render_html(
-                    report, run.figures, animation=animation_of(run),
-                    assembly_glb=glb.read_bytes() if glb.is_file() else None), encoding="utf-8")
+                    report, run.figures, animation=animation_of(run), assembly_glb=glb,
+                    assembly_view=view_glb(glb, getattr(run, "cache", None)) if glb else None),
+                    encoding="utf-8")
                 files.append("report.html")
                 progress.step(WRITE_STAGE, "report.html")
             report["files"] = sorted(files)

@@ -10,8 +10,10 @@ generates no teeth, builds no solids and never imports fcl.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 __all__ = ["EFFECT_STAGES", "STAGE_NEEDS", "STAGE_ORDER", "NOT_APPLICABLE", "plan",
-           "scene_plan", "stage_warnings"]
+           "scene_plan", "stage_warnings", "BuildPlan", "check_build"]
 
 
 #: The stages each effect needs (their own needs are added by :func:`plan`).
@@ -131,3 +133,59 @@ def stage_warnings(params, stages) -> list:
     if refused:
         raise ParameterError(refused)
     return [p for p in problems if p.stage not in stages]
+
+
+@dataclass(frozen=True)
+class BuildPlan:
+    """What a build of a design will do, decided before any stage runs (:func:`check_build`).
+
+    Attributes
+    ----------
+    params
+        The design with its accuracy preset's knobs (those the file leaves out).
+    preset : str
+    knobs : dict
+        ``{knob path: (value, "preset" | "file")}``.
+    effects : tuple
+    case : str
+    stages : list
+        The stages it runs, in order.
+    set_aside : dict
+        ``{effect: reason}``: effects that mean nothing for this design or case.
+    warnings : list
+        Problems of stages it does not run (a build running them would refuse the design).
+    """
+
+    params: object
+    preset: str
+    knobs: dict
+    effects: tuple
+    case: str
+    stages: list
+    set_aside: dict
+    warnings: list
+
+
+def check_build(params, *, effects=None, case=None, preset=None) -> BuildPlan:
+    """What :func:`cadgen.build` will do with ``params``: its stages, or its refusal.
+
+    The one decision both ``cadgen build`` and ``cadgen validate`` make: validate answers for
+    the file's own scene (``effects``, ``case`` and ``preset`` left None), so a problem that
+    refuses the build is an error there too, and one of a stage the scene does not run is a
+    warning in both.
+
+    Raises
+    ------
+    cadgen.params.ParameterError
+        What a build refuses before any stage runs: a problem of a stage the scene runs
+        (:func:`stage_warnings`), or no effect of the scene applying to the design.
+    """
+    from cadgen.params.scene import apply_preset
+
+    scene = params.scene
+    preset = preset or scene.preset
+    params, knobs = apply_preset(params, preset)
+    effects = tuple(effects) if effects is not None else scene.effects
+    case = case or scene.case
+    stages, set_aside, warnings = scene_plan(params, effects, case)
+    return BuildPlan(params, preset, knobs, effects, case, stages, set_aside, warnings)
