@@ -182,7 +182,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
     try:
         with OptimizePrinter(sys.stderr) as printer:
-            result = cadgen.optimize_study(study, workers=args.workers,
+            result = cadgen.optimize_study(study, workers=args.workers or os.cpu_count() or 1,
                                            scheduler=args.scheduler, progress=printer)
     except cadgen.MechanismError as exc:   # the scheduler cannot be reached, say
         print(f"cadgen optimize: {_one_line(exc)}", file=sys.stderr)
@@ -316,8 +316,9 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
         "target), 2 for a study file with problems (every one listed; nothing written), 3 on "
         "an internal error.")
     optimize.add_argument("study", metavar="STUDY", help="TOML study file")
-    optimize.add_argument("--workers", metavar="N", type=_whole_number(1), default=1,
-                          help="local processes screening each population (default: 1)")
+    optimize.add_argument("--workers", metavar="N", type=_whole_number(1), default=None,
+                          help=f"local processes screening each population (default: the "
+                               f"number of CPUs, {os.cpu_count()} here, as for batch)")
     optimize.add_argument("--scheduler", metavar="ADDRESS", default=None,
                           help="screen on a Dask cluster (tcp://host:8786) instead")
     optimize.add_argument("--build", action="store_true",

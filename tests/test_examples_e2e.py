@@ -125,6 +125,14 @@ def test_batch_every_grid(grid, tmp_path):
     for name in built:
         report = json.loads((out / name / "report.json").read_text(encoding="utf-8"))
         assert report["design"] == name
+        # each clearance under the name of what measured it, as the report labels it: the
+        # solids' sweep and, beside it, the metrics stage's centre-line estimate
+        row = next(row for row in table if row["design"] == name)
+        arm = next(m for m in report["metrics"] if m["key"] == "arm_distance")
+        assert arm["label"] == "arm distance (solids, FCL)"
+        assert float(row["arm_distance (solids, FCL)"]) == pytest.approx(arm["value"], rel=1e-6)
+        assert float(row["arm_distance (centre lines)"]) == pytest.approx(
+            arm["kinematic_estimate"], rel=1e-6)
     failed = sum(not row["output"] for row in table)
     assert result.returncode == (1 if failed else 0)
     assert f"{count} designs in " in result.stdout

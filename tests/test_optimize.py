@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import cadgen
 from cadgen.cli import main
@@ -225,8 +227,40 @@ def test_best_toml_keeps_the_base_files_comments_and_names_the_study(from_failin
     assert text.startswith("# best.toml of the study 'short-l2' (study.toml)")
     assert "seed 1" in text.splitlines()[1]
     base = (study_path.parent / "base.toml").read_text(encoding="utf-8")
-    kept = [line for line in base.splitlines() if line.startswith("#")]
+    lines = base.splitlines()
+    first_key = next(k for k, line in enumerate(lines) if line and not line.startswith("#"))
+    # the comments among the values are kept; the base's header (its description, "check it
+    # with: cadgen validate <the base file>") is not: it is not true of this file
+    kept = [line for line in lines[first_key:] if line.startswith("#")]
     assert kept and all(line in text for line in kept)
+    assert not [line for line in lines[:first_key] if line.strip("# ") and line in text]
+
+
+def test_best_toml_is_rounded_to_shop_precision_and_certified_as_written(from_failing):
+    # every free length to 0.01 mm (the default step of a length), written that way, and the
+    # exact evaluator of the file as written gives what optimize.json certified
+    study_path, folder, _ = from_failing
+    text = (folder / "best.toml").read_text(encoding="utf-8")
+    best = cadgen.load_params(folder / "best.toml")
+    study = tomllib.loads(study_path.read_text(encoding="utf-8"))
+    data = json.loads((folder / "optimize.json").read_text(encoding="utf-8"))
+    base = cadgen.load_params(study_path.parent / "base.toml")
+    for path, value in zip(study["free"], free_values(best, study["free"])):
+        assert round(value * 100) == pytest.approx(value * 100, abs=1e-9), (path, value)
+        table, key = path.split(".")
+        line = next(line for line in text.splitlines() if line.startswith(f"{key} "))
+        written = line.split("=")[1].split("#")[0].strip()
+        assert len(written.partition(".")[2]) <= 2, line
+        old = getattr(getattr(base, table), key)
+        if old != value:   # its comment says what it was
+            assert f"(cadgen optimize; base.toml: {old:g})" in line, line
+    assert f'name = "{best.name}"' in text and f"outputs/{best.name}/" in text
+    evaluation = cadgen.evaluate(best)
+    for metric in evaluation.metrics:
+        key = metric.key if metric.spacing is None else f"{metric.key}@{metric.spacing:g}"
+        certified = data["best"]["exact"]["values"].get(key)
+        if certified is not None and metric.value is not None:
+            assert metric.value == pytest.approx(certified, rel=1e-12, abs=1e-12), key
 
 
 def test_the_report_gives_screened_exact_and_their_difference(from_failing):
@@ -339,3 +373,22 @@ def test_an_unreachable_scheduler_is_one_line_exit_2(tmp_path, capsys, monkeypat
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("cadgen optimize: cannot reach the Dask scheduler tcp://127.0.0.1:9")
     assert not out.exists()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(-1e3, 1e3), min_size=1, max_size=6),
+       st.sampled_from([0.01, 0.25, 0.5, 1e-4, 2.0]), st.floats(-50, 50), st.floats(1, 400))
+def test_rounding_snaps_to_the_nearest_step_inside_the_bounds(values, step, low, width):
+    # each value goes to the multiple of the step nearest it among those within the bounds
+    # (a brute-force scan of the grid), duplicates dropped, the order kept
+    from cadgen.optimize.run import _rounded
+
+    high = low + width
+    column = np.clip(np.asarray(values), low, high)
+    out = _rounded(column[:, None], np.array([step]), [low], [high])[:, 0]
+    grid = np.arange(np.ceil(low / step - 1e-9), np.floor(high / step + 1e-9) + 1) * step
+    expected = [grid[np.argmin(np.abs(grid - v) + 1e-12 * np.arange(len(grid)))]
+                for v in column]
+    unique = list(dict.fromkeys(round(e, 9) for e in expected))
+    assert np.allclose(out, unique, atol=1e-9)
+    assert np.all((out >= low - 1e-9) & (out <= high + 1e-9))

@@ -101,6 +101,14 @@ BAD = [
     ('[free]\n"planter.L2" = [150.0, 230.0]\n', "objectives", "missing", ["[objectives]"]),
     ('[free]\n"planter.L2" = [150.0, 230.0]\n[objectives]\nmaximize = ["min_margin"]\n'
      'algorithm = "GA"\n', "objectives.algorithm", "unknown_key", ["maximize, minimize"]),
+    ('[free]\n"planter.L2" = [150.0, 230.0]\n[objectives]\nmaximize = ["min_margin"]\n'
+     '[precision]\n"planter.L1" = 0.5\n', 'precision."planter.L1"', "unknown_key",
+     ["not a free path", "planter.L2"]),
+    ('[free]\n"planter.L2" = [150.0, 230.0]\n[objectives]\nmaximize = ["min_margin"]\n'
+     '[precision]\n"planter.L2" = 80.0\n', 'precision."planter.L2"', "out_of_range",
+     ["below its range (80)", "not 80.0"]),
+    ('[free]\n"planter.L2" = [150.0, 230.0]\n[objectives]\nmaximize = ["min_margin"]\n'
+     '[precision]\n"planter.L2" = "0.5"\n', 'precision."planter.L2"', "wrong_type", ['"0.5"']),
 ]
 
 
@@ -176,3 +184,13 @@ def test_pricking_studies_move_the_points_within_a_box(tmp_path):
                           'free."trajectory.points".points[3]', 'free."linkage.rocker"',
                           "objectives.maximize[1]"}
     assert found['free."trajectory.points".points[3]'].code == "duplicate"
+
+
+def test_rounding_steps_by_unit_unless_the_study_gives_one(tmp_path):
+    body = GOOD.replace('[free]\n', '[free]\n"pitch_curve.e1" = [2.5, 2.8]\n'
+                        '"pitch_curve.f1_rad" = [8.4, 8.7]\n"train.phi0_deg" = [80.0, 100.0]\n')
+    study = load_study(write_study(tmp_path, body + '[precision]\n"planter.L2" = 0.5\n'))
+    assert study.steps == {"planter.L2": 0.5, "pitch_curve.b1": 0.01, "pitch_curve.e1": 1e-4,
+                           "pitch_curve.f1_rad": 1e-4, "train.phi0_deg": 0.01}
+    kernel = STUDIES / "kernel-a-convex.toml"
+    assert load_study(kernel).steps == {"trajectory.points": 0.01}

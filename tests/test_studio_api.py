@@ -674,3 +674,23 @@ def test_help_does_not_import_the_web_stack():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           env={**os.environ, "PYTHONPATH": str(REPO)})
     assert done.stdout.strip() == "[]", done.stderr
+
+
+def test_the_studio_names_each_clearance_as_a_metrics_build_does():
+    # the studio evaluates without solids: its clearances are the centre lines' and the
+    # envelope circles', under the labels a metrics-only build prints and reports
+    from cadgen.params import load_params
+    from cadgen.pipeline.build import build
+    from cadgen.studio.payload import evaluate_request
+    from tests.helpers import REFERENCE, reference_text
+
+    import tomllib
+
+    status, answer = evaluate_request(tomllib.loads(reference_text()))
+    assert status == 200
+    studio = {m["key"]: m["label"] for m in answer["metrics"] if m.get("spacing_mm") is None}
+    report = build(load_params(REFERENCE), None, effects=["metrics"]).report
+    built = {m["key"]: m["label"] for m in report["metrics"] if m.get("spacing_mm") is None}
+    assert studio["arm_distance"] == built["arm_distance"] == "arm distance (centre lines)"
+    assert studio["ground_clearance"] == built["ground_clearance"] == \
+        "gearbox ground clearance (envelope circles)"

@@ -57,6 +57,19 @@ def _flag(value: Any) -> bool | None:
     return None if value is None else bool(value)
 
 
+#: Metrics two methods measure (the kinematic estimate of the metrics stage, the FCL sweep of
+#: the solids): a summary's id names the method, as the report's label does.
+MEASURED_BY_METHOD = ("arm_distance", "ground_clearance")
+
+
+def _with_method(key: str, label: str) -> str:
+    """``key (method)`` from a label ending in its method: ``arm distance (solids, FCL)``."""
+    import re
+
+    method = re.search(r"\(([^()]*)\)\s*$", label or "")
+    return f"{key} ({method.group(1)})" if method else key
+
+
 def _report_metrics(report: Mapping) -> dict:
     """``{metric id: {value, unit, target, passed}}`` of a report, in report order.
 
@@ -68,6 +81,12 @@ def _report_metrics(report: Mapping) -> dict:
     for m in report.get("metrics", ()):
         spacing = m.get("spacing_mm")
         key = m["key"] if spacing is None else f"{m['key']}@{float(spacing):g}mm"
+        if m["key"] in MEASURED_BY_METHOD:   # what was measured is in the id: the centre
+            key = _with_method(key, m["label"])   # lines' estimate or the solids' sweep
+            if m.get("kinematic_estimate") is not None:
+                metrics[_with_method(m["key"], m.get("kinematic_label", ""))] = {
+                    "value": _number(m["kinematic_estimate"]), "unit": m.get("unit", ""),
+                    "target": m.get("target"), "passed": None}
         metrics[key] = {"value": _number(m.get("value")), "unit": m.get("unit", ""),
                         "target": m.get("target"), "passed": _flag(m.get("passed"))}
     if report.get("mechanism") == "pricking":

@@ -117,8 +117,82 @@ def best_toml_text(result, *, date: datetime.date | None = None) -> str:
               f"{verdict}",
               f"# exact {objectives}",
               f"# changed from {study.base_path.name}: {changes}",
-              ""]
+              f"# (the base design's own description is in {study.base_path.name}; the comments "
+              "below are its, each changed value's saying so)",
+              "", ""]
+    body = _true_comments(body, result, tables["name"])
     return "\n".join(header) + body
+
+
+def _true_comments(body: str, result, name: str) -> str:
+    """The base file's text made true for the new file: its header (which describes the
+    base design and names its file) left out, the name's comment naming the new output
+    folder, and each changed value's comment saying what it was."""
+    import re
+
+    lines = body.split("\n")
+    while lines and (lines[0].startswith("#") or not lines[0].strip()):
+        lines.pop(0)   # the base file's header: our own stands above
+    body = "\n".join(lines)
+    body = re.sub(r'(?m)^(name\s*=\s*"[^"]*"\s*)#.*$',
+                  lambda m: f"{m.group(1)}# design name; outputs are written to "
+                            f"outputs/{name}/", body, count=1)
+    base = result.base.x if result.base else None
+    chosen = result.chosen
+    if chosen is None or base is None:
+        return body
+    if result.study.kind == "pricking":
+        return _moved_points_comments(body, result)
+    for path, old, new in zip(result.variables, base, chosen.x):
+        if _number(old) == _number(new):
+            continue
+        table, _, key = path.rpartition(".")
+        body = _comment_after(body, table, key, f"(cadgen optimize; {result.study.base_path.name}: "
+                                                f"{_number(old)})")
+    return body
+
+
+def _comment_after(body: str, table: str, key: str, note: str) -> str:
+    """``body`` with ``note`` added to the comment of ``key`` in ``[table]`` (or one made)."""
+    import re
+
+    header = re.search(rf"(?m)^\[{re.escape(table)}\][^\n]*$", body) if table else None
+    start = header.end() if header else 0
+    following = re.search(r"(?m)^\[", body[start:]) if header else None
+    end = start + following.start() if following else len(body)
+    section = body[start:end]
+    line = re.search(rf"(?m)^({re.escape(key)}\s*=\s*[^#\n]*?)(\s*#[^\n]*)?$", section)
+    if line is None:
+        return body
+    comment = (line.group(2) or "").rstrip()
+    text = f"{line.group(1)}{comment} {note}" if comment else f"{line.group(1)}   # {note}"
+    return body[:start] + section[:line.start()] + text + section[line.end():] + body[end:]
+
+
+def _moved_points_comments(body: str, result) -> str:
+    """The comment of each moved type-value point says where it was in the base file."""
+    import re
+
+    moved = {}
+    for name, value in zip(result.variables, result.chosen.x - result.base.x):
+        number = int(name[1:].split(".")[0])
+        if abs(value) > 0:
+            moved[number] = True
+    base_points = result.study.base_params.trajectory.points
+    block = re.search(r"(?ms)^points\s*=\s*\[[^\n]*\n(.*?)^\s*\]", body)
+    if block is None:
+        return body
+    rows, number = [], 0
+    for line in block.group(1).split("\n"):
+        match = re.match(r"(\s*\[[^\]]*\],?)(.*)$", line)
+        if match:
+            number += 1
+            if number in moved:
+                x, y = base_points[number - 1]
+                line = (f"{match.group(1)}   # Q{number} moved by cadgen optimize from "
+                        f"({_number(x)}, {_number(y)})")
+        rows.append(line)
+    return body[:block.start(1)] + "\n".join(rows) + body[block.end(1):]
 
 
 # --------------------------------------------------------------------------- pareto.csv

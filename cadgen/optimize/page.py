@@ -71,6 +71,12 @@ def _min_margin(design) -> float | None:
     return design.min_margin
 
 
+#: The clearances the screen and the exact evaluator measure, named by method as the build's
+#: report and summary name them (a build with solids measures them on the solids with FCL).
+MEASURED = {"arm_distance": "arm_distance (centre lines)",
+            "ground_clearance": "ground_clearance (envelope circles)"}
+
+
 def _targets_table(result) -> str:
     chosen, base = result.chosen, result.base
     labels = list(result.constraint_labels)
@@ -79,7 +85,7 @@ def _targets_table(result) -> str:
         exact_margin = chosen.exact.get("margins", {}).get(label)
         screened_margin = chosen.screened.get("margins", {}).get(label)
         base_margin = base.exact.get("margins", {}).get(label) if base else None
-        rows.append([label,
+        rows.append([MEASURED.get(label, label),
                      _n(base.exact.get("values", {}).get(label)) if base else "",
                      _n(base_margin, 4), (_verdict(None if base_margin is None
                                                    else base_margin >= 0),),

@@ -157,7 +157,10 @@ class PrickingProblem:
     def tables_at(self, x) -> dict:
         """The base design's tables (every value, as a file would hold it) with ``x`` applied."""
         tables = copy.deepcopy(self.base_params.model_dump(mode="json", exclude_none=True))
-        tables["trajectory"]["points"] = [[float(px), float(py)] for px, py in self.points_at(x)]
+        # to 1e-9 mm: the base point plus a rounded displacement, written as a person would
+        # (-3.14, not -3.1399999999999997)
+        tables["trajectory"]["points"] = [[round(float(px), 9), round(float(py), 9)]
+                                          for px, py in self.points_at(x)]
         return tables
 
     def _screen_params(self, x):

@@ -40,6 +40,7 @@ the run's exit code is 1.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -326,6 +327,52 @@ def _natural(value: float, sense: str) -> float:
     return -value if sense == "max" else value
 
 
+def _screened(problem, X: np.ndarray) -> list[dict]:
+    """The screen's figures of each row of ``X`` (as :meth:`_Archive.screened` gives them)."""
+    screened = problem.evaluate(np.atleast_2d(np.asarray(X, dtype=float)))
+    out = []
+    for row in range(len(X)):
+        G = np.asarray(screened["G"][row], dtype=float)
+        F = np.asarray(screened["F"][row], dtype=float)
+        out.append({
+            "values": {k: float(np.asarray(v)[row]) for k, v in screened["values"].items()},
+            "margins": dict(zip(problem.constraint_labels, (-G).tolist())),
+            "objectives": {key: _natural(float(f), sense)
+                           for (key, sense), f in zip(problem.objectives, F)},
+            "feasible": bool(np.asarray(screened["valid"])[row] and np.all(G <= 0.0)),
+            "violation": float(np.maximum(G, 0.0).sum())})
+    return out
+
+
+def _variable_steps(study, problem) -> np.ndarray:
+    """Each variable's rounding step (0: not rounded): the study's steps by free path; a
+    pricking study's displacements all take its points' step."""
+    steps = getattr(study, "steps", None) or {}
+    if getattr(study, "kind", None) == "pricking":
+        return np.full(len(problem.variables), steps.get("trajectory.points", 0.0))
+    return np.array([steps.get(name, 0.0) for name in problem.variables], dtype=float)
+
+
+def _decimals(step: float) -> int:
+    """The decimals that write ``step`` exactly (0.01 -> 2, 0.25 -> 2, 0.5 -> 1, 2 -> 0)."""
+    return next((d for d in range(13) if round(step, d) == step), 12)
+
+
+def _rounded(X: np.ndarray, steps: np.ndarray, lower, upper) -> np.ndarray:
+    """The rows of ``X`` with each column rounded to its step within its bounds (a value
+    rounded out of them takes the nearest step inside), duplicates after rounding dropped
+    (first kept: the order is best first). A step of 0 leaves the column as it is."""
+    X = np.array(X, dtype=float, ndmin=2)
+    for j, step in enumerate(np.asarray(steps, dtype=float)):
+        if step > 0:
+            low = math.ceil(lower[j] / step - 1e-9) * step
+            high = math.floor(upper[j] / step + 1e-9) * step
+            column = np.clip(np.round(X[:, j] / step) * step, low, high)
+            X[:, j] = np.round(column, _decimals(step))   # 188.99, not 188.99000000000001
+    _, first = np.unique(X, axis=0, return_index=True)
+    return X[np.sort(first)]
+
+
 # --------------------------------------------------------------------------- selection
 
 
@@ -521,31 +568,30 @@ def optimize_study(study, *, workers: int = 1, scheduler: str | None = None,
             rows = _single_candidates(archive)
         certify_started = time.perf_counter()
         finals: list[FinalDesign] = []
-        a = archive.arrays()
-        batch = rows[:max_certified if len(objectives) > 1 else min(CERTIFY_FIRST, max_certified)]
+        # the designs certified are the ones a workshop is given: rounded to the study's
+        # steps (0.01 mm...), screened again and certified as rounded
+        candidates = _rounded(archive.arrays()["X"][rows], _variable_steps(study, problem),
+                              lower, upper) if rows else np.zeros((0, len(lower)))
+        batch = list(range(min(len(candidates), max_certified if len(objectives) > 1
+                               else min(CERTIFY_FIRST, max_certified))))
         total = len(batch)
         while batch:
-            exact = evaluator.certify([a["X"][k] for k in batch])
-            for k, result in zip(batch, exact):
-                finals.append(FinalDesign(np.array(a["X"][k]), archive.screened(k), result))
+            exact = evaluator.certify([candidates[k] for k in batch])
+            screened = _screened(problem, candidates[batch])
+            for k, shown, result in zip(batch, screened, exact):
+                finals.append(FinalDesign(np.array(candidates[k]), shown, result))
                 report("certify", generation, len(finals), total)
             if len(objectives) > 1 or any(f.passed for f in finals):
                 break
-            batch = rows[len(finals):min(len(rows), max_certified, 2 * len(finals))]
+            batch = list(range(len(finals), min(len(candidates), max_certified,
+                                                 2 * len(finals))))
             total += len(batch)
 
         base_design = None
         if np.all(np.isfinite(base)):
-            screened = problem.evaluate(base[None, :])
-            G = np.asarray(screened["G"][0], dtype=float)
             [base_exact] = evaluator.certify([base])
-            base_design = FinalDesign(base, {
-                "values": {k: float(np.asarray(v)[0]) for k, v in screened["values"].items()},
-                "margins": dict(zip(problem.constraint_labels, (-G).tolist())),
-                "objectives": {key: _natural(float(f), sense) for (key, sense), f in
-                               zip(objectives, np.asarray(screened["F"][0], dtype=float))},
-                "feasible": bool(np.asarray(screened["valid"])[0] and np.all(G <= 0.0)),
-                "violation": float(np.maximum(G, 0.0).sum())}, base_exact, role="base")
+            base_design = FinalDesign(base, _screened(problem, base[None, :])[0], base_exact,
+                                      role="base")
         certify_seconds = time.perf_counter() - certify_started
         where = evaluator.describe()
 

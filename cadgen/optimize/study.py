@@ -14,6 +14,14 @@ budget; the base file's targets are the constraints::
     [budget]
     evaluations = 20000                     # designs screened (default 2000)
     seed = 1                                # same seed, same result (default 1)
+    [precision]                             # optional: the step each free value is
+    "planter.L2" = 0.5                      # rounded to before it is certified
+
+The final designs are rounded to shop precision before they are certified, and the rounded
+design is the one certified, written to best.toml and built: each free value to its
+``[precision]`` step, else by its unit (:data:`DEFAULT_STEPS`: 0.01 mm for lengths, 0.01
+deg, 1e-4 rad or 1e-4 for a ratio); the pricking points' displacements to
+``[precision] "trajectory.points"`` (0.01 mm by default).
 
 A pricking study moves the type-value points within a box:
 ``[free] "trajectory.points" = { box = 3.0 }`` (every point), or ``{ box = 3.0, points =
@@ -37,7 +45,7 @@ import difflib
 import math
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -49,9 +57,12 @@ from cadgen.params.side_files import (assign_dotted as _assign, flatten_dotted, 
 from cadgen.params.side_files import is_number as _is_number, show as _show
 
 __all__ = ["Study", "StudyError", "load_study", "STUDY_KEYS", "DEFAULT_EVALUATIONS",
-           "DEFAULT_SEED", "MAX_EVALUATIONS"]
+           "DEFAULT_SEED", "MAX_EVALUATIONS", "DEFAULT_STEPS"]
 
-STUDY_KEYS = ("base", "name", "free", "objectives", "budget")
+STUDY_KEYS = ("base", "name", "free", "objectives", "budget", "precision")
+#: The rounding step of a free value by its unit, when the study's [precision] gives none:
+#: what a drawing or a workshop states (0.01 mm, 0.01 deg); a ratio or a radian to 1e-4.
+DEFAULT_STEPS = {"mm": 0.01, "deg": 0.01, "rad": 1e-4, None: 1e-4}
 _SENSES = {"maximize": "max", "minimize": "min"}
 _BUDGET_KEYS = ("evaluations", "seed")
 _BOX_KEYS = ("box", "points")
@@ -93,6 +104,9 @@ class Study:
         The budget of screened designs and the random seed.
     text : str
         The study file's text (for the report).
+    steps : dict
+        ``{free path: rounding step}`` of every free path (``trajectory.points`` for a
+        pricking study): the finals are rounded to these before they are certified.
     """
 
     path: Path
@@ -105,6 +119,7 @@ class Study:
     evaluations: int
     seed: int
     text: str = ""
+    steps: dict = field(default_factory=dict)
 
     def with_budget(self, *, evaluations: int | None = None, seed: int | None = None) -> "Study":
         """This study with the command line's ``--evaluations`` / ``--seed`` instead."""
@@ -288,6 +303,42 @@ def _check_objectives(table: Any, known: list | None) -> tuple[list, list[Proble
     return objectives, problems
 
 
+def _check_precision(table: Any, free: Any, kind: str | None) -> tuple[dict, list[Problem]]:
+    """``{free path: rounding step}`` of every free path (``[precision]`` or by its unit), or
+    the table's problems: a key that is not a free path, a step that is not a positive
+    number smaller than the path's range."""
+    if free is None or kind is None:
+        return {}, []
+    if kind == "pricking":
+        spans = {POINTS_PATH: 2 * free["box"]}
+        defaults = {POINTS_PATH: DEFAULT_STEPS["mm"]}
+    else:
+        units = _numeric_fields(kind)
+        spans = {path: high - low for path, low, high in free}
+        defaults = {path: DEFAULT_STEPS.get(units[path]["unit"], DEFAULT_STEPS[None])
+                    for path in spans}
+    if table is None:
+        return defaults, []
+    if not isinstance(table, dict):
+        return {}, [Problem("precision", "wrong_type",
+                            f"precision must be a table, not {_show(table)}")]
+    steps, problems = dict(defaults), []
+    for key, step in flatten_dotted(table, ()):
+        where = f'precision."{key}"'
+        if key not in spans:
+            close = difflib.get_close_matches(key, list(spans), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            problems.append(Problem(where, "unknown_key", f"{key} is not a free path of this "
+                                    f"study{hint}; free: {', '.join(spans)}"))
+        elif not (_is_number(step) and math.isfinite(step) and 0 < step < spans[key]):
+            problems.append(Problem(where, "out_of_range" if _is_number(step) else "wrong_type",
+                                    f"the rounding step of {key} must be a positive number "
+                                    f"below its range ({spans[key]:g}), not {_show(step)}"))
+        else:
+            steps[key] = float(step)
+    return steps, problems
+
+
 def _check_budget(table: Any) -> tuple[int, int, list[Problem]]:
     if table is None:
         return DEFAULT_EVALUATIONS, DEFAULT_SEED, []
@@ -409,8 +460,10 @@ def load_study(path: str | os.PathLike) -> Study:
     problems += found
     evaluations, seed, found = _check_budget(data.get("budget"))
     problems += found
+    steps, found = _check_precision(data.get("precision"), free, kind)
+    problems += found
     if problems or base_params is None:
         raise StudyError(problems, source)
     return Study(path=study_path, name=name, base_path=base_path, base_params=base_params,
                  kind=kind, free=free, objectives=tuple(objectives), evaluations=evaluations,
-                 seed=seed, text=text)
+                 seed=seed, text=text, steps=steps)

@@ -213,6 +213,7 @@ def _replace_kinematic_estimates(report: dict, sweeps: dict) -> None:
                             "ground_clearance": "ground_clearance"}.get(metric["key"], ""))
         if sweep:
             metric["kinematic_estimate"] = metric["value"]
+            metric["kinematic_label"] = metric["label"]   # its method named: centre lines...
             metric["value"] = sweep["minimum_mm"]
             metric["label"] = sweep["label"]
             metric["passed"] = sweep["passed"]

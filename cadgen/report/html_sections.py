@@ -397,8 +397,10 @@ def _searches_table(searches: dict) -> str:
         label = name.replace("_", " ")
         if search.get("maximum"):
             label += " (a maximum: its bound is an upper one)"
-        elif name in ("arm_distance", "ground_clearance"):
-            label += " (kinematic estimate)"
+        elif name == "arm_distance":   # named by method, as the metrics' tables name it
+            label += " (centre lines)"
+        elif name == "ground_clearance":
+            label = "gearbox ground clearance (envelope circles)"
         rows.append([_e(label), _e(_number(value)), _e(_number(bound)),
                      "yes" if search.get("certified") else _badge("warn") + " no",
                      _e(_scientific(search.get("gap"))), _e(_scientific(search.get("atol"))),
