@@ -370,6 +370,16 @@ def polar_curvature(curve, t):
     return (r**2 + 2 * dr**2 - r * ddr) / (r**2 + dr**2) ** 1.5
 
 
+def _finer_module(largest: float, path: str) -> str:
+    """What cuts a stretch that needs a module of at most ``largest`` mm, as advice."""
+    from kinematics.profile_shift import MIN_PRACTICAL_MODULE
+
+    if largest >= MIN_PRACTICAL_MODULE:
+        return f"a module of at most {largest:.3f} mm cuts it (more teeth: {path}.teeth)"
+    return (f"no practical module cuts it (it would take one below {max(largest, 0.0):.3g} mm, "
+            f"under {MIN_PRACTICAL_MODULE:g} mm)")
+
+
 def pair_problems(closure: Closure, module: float, *, path: str = "pitch_curve",
                   min_radius_modules: float = tol.MIN_PITCH_RADIUS_MODULES) -> list:
     """Why a closed non-circular pair cannot be cut with ``module`` (empty when it can).
@@ -388,12 +398,15 @@ def pair_problems(closure: Closure, module: float, *, path: str = "pitch_curve",
             f"the central gear's pitch radius falls to {r_min:.3f} mm at t = "
             f"{np.degrees(t_min):.2f} deg, below {min_radius_modules:g} modules ({limit:.3f} mm "
             f"at module {module:.3f} mm): that stretch is pointed and cannot be cut with this "
-            "module (fewer teeth, or a rounder pitch curve)"))
+            f"module; {_finer_module(r_min / min_radius_modules, path)}, or a rounder pitch "
+            "curve"))
     if gap < limit:
         problems.append(Problem(
             path, "tiny_intermediate_radius",
             f"the intermediate gear's radius a - r1 falls to {gap:.3f} mm at t = "
             f"{np.degrees(t_max):.2f} deg (a = {closure.centre_distance:.4f} mm, ratio swing "
             f"1:{closure.ratio_swing:.1f}), below {min_radius_modules:g} modules ({limit:.3f} mm): "
-            f"it cannot be cut with module {module:.3f} mm"))
+            f"it cannot be cut with module {module:.3f} mm; "
+            f"{_finer_module(gap / min_radius_modules, path)}, or a pitch curve of a smaller "
+            "ratio swing"))
     return problems

@@ -105,16 +105,12 @@ def _planter(paper_curve, **changes):
 @pytest.mark.parametrize("L1, crossing", [(250.0, True), (242.64, False), (242.6408, False)],
                          ids=["crossing", "0.8-um-apart", "35-nm-apart"])
 def test_arms_that_cross_or_nearly_touch_are_certified_quickly(paper_curve, L1, crossing):
-    import time
-
     mechanism = _planter(paper_curve, L1=L1)
-    start = time.perf_counter()
     result = arm_distance(mechanism)
-    seconds = time.perf_counter() - start
-    # (i) a small budget: the search stopped on its own, well inside it (was 1.6 million
-    # evaluations and 8 to 20 s for the crossing design)
+    # (i) a small budget: the search stopped on its own, well inside it (its speed is the
+    # benchmark's to measure; the evaluations count does not depend on a busy machine)
     assert result.certified and not result.budget_spent
-    assert result.evaluations < 100_000 and seconds < 2.0
+    assert result.evaluations < 100_000
     # (ii) agrees with 200,000 poses of an independent distance within its stated gap
     brute, dense = _brute_minimum(mechanism, 200_001)
     assert result.bound <= brute + 1e-12

@@ -6,7 +6,6 @@ import os
 import re
 import subprocess
 import sys
-import time
 import types
 from pathlib import Path
 
@@ -339,9 +338,7 @@ def test_unusable_output_dir_exits_2_before_any_work(case, command, tmp_path, mo
     args = [command, str(REFERENCE)] if command != "batch" else [command, "--grid",
                                                                  str(ROOT / "params" / "grids"
                                                                      / "l2-sweep.toml")]
-    start = time.perf_counter()
-    assert main([*args, "--output-dir", str(directory)]) == EXIT_PROBLEMS
-    assert time.perf_counter() - start < 1.0
+    assert main([*args, "--output-dir", str(directory)]) == EXIT_PROBLEMS   # no_work: none
     captured = capsys.readouterr()
     (line,) = captured.err.splitlines()
     assert line.startswith(f"cadgen: output directory {directory}: ") and reason in line

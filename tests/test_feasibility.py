@@ -85,3 +85,59 @@ def test_depth_beyond_the_tip_path_is_rejected():
 def test_structural_and_unrelated_problems_are_reported_together():
     text = edited(depth=-1.0, L1='"130"')
     assert codes(text) == {("field.depth", "out_of_range"), ("planter.L1", "wrong_type")}
+
+
+@pytest.mark.parametrize("teeth, refused", [(22, False), (49, False), (50, True), (704, True)])
+def test_a_module_under_half_its_target_is_refused_where_the_teeth_are_cut(teeth, refused,
+                                                                            tmp_path, capsys):
+    # by hand: the paper's module is 2.7911 mm at 22 teeth, a pitch perimeter of
+    # pi 22 x 2.7911 = 192.91 mm; half the 2.5 mm target is 1.25 mm, and 192.91 / (pi 49) =
+    # 1.2532 mm stays above it while 192.91 / (pi 50) = 1.2281 mm falls below
+    from cadgen.cli import main
+
+    path = tmp_path / "fine.toml"
+    path.write_text(edited(teeth=str(teeth)), encoding="utf-8")
+    code = main(["validate", str(path)])
+    out = capsys.readouterr().out
+    if not refused:
+        assert code == 0 and "module_far_below_target" not in out
+        return
+    assert code == 2
+    [line] = [line for line in out.splitlines() if "module_far_below_target" in line]
+    assert line.startswith(f"{path}: pitch_curve.teeth: {teeth} teeth")
+    # the advice: the most teeth whose module meets the target, floor(192.91 / (pi 2.5)) = 24
+    assert "pitch_curve.teeth = 24 or fewer" in line
+    # a metrics-only build reports the module's failure and keeps this as a warning
+    assert main(["build", str(path), "--effects", "metrics", "--output-dir",
+                 str(tmp_path / "out")]) == 1
+    assert "module_far_below_target" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("table, key, value", [("pitch_curve", "teeth", 1001),
+                                               ("solids", "segments_per_circle", 1025),
+                                               ("gears", "meshing_poses", 4001)])
+def test_knobs_beyond_what_a_build_does_in_ten_times_its_time_are_refused(table, key, value):
+    from tests.helpers import with_keys
+
+    with pytest.raises(ParameterError) as caught:
+        validate_text(with_keys(reference_text(), table, **{key: str(value)}))
+    assert [(p.path, p.code) for p in caught.value.problems] == [(f"{table}.{key}",
+                                                                  "out_of_range")]
+
+
+def test_a_pointed_stretch_names_the_module_that_cuts_it_and_that_module_does():
+    # 6 teeth on the paper's curve are a module of 192.91 / (pi 6) = 10.23 mm: pointed. The
+    # advice's module, turned into a tooth count by hand, validates.
+    import math
+    import re
+
+    with pytest.raises(ParameterError) as caught:
+        validate_text(edited(teeth="6"))
+    advice = [float(re.search(r"a module of at most ([0-9.]+) mm", p.message).group(1))
+              for p in caught.value.problems
+              if p.code in ("pointed_pitch_curve", "tiny_intermediate_radius")]
+    assert advice and all("more teeth: pitch_curve.teeth" in p.message
+                          for p in caught.value.problems)
+    teeth = math.ceil(np.pi * 22 * 2.79111 / (np.pi * min(advice)))
+    assert teeth > 6
+    validate_text(edited(teeth=str(teeth)))   # no pointed stretch any more

@@ -377,11 +377,11 @@ def test_an_unreachable_scheduler_is_one_line_exit_2(tmp_path, capsys, monkeypat
 
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.floats(-1e3, 1e3), min_size=1, max_size=6),
-       st.sampled_from([0.01, 0.25, 0.5, 1e-4, 2.0]), st.floats(-50, 50), st.floats(1, 400))
+       st.sampled_from([0.01, 0.25, 0.5, 1e-4, 2.0]), st.floats(-50, 50), st.floats(2, 400))
 def test_rounding_snaps_to_the_nearest_step_inside_the_bounds(values, step, low, width):
     # each value goes to the multiple of the step nearest it among those within the bounds
     # (a brute-force scan of the grid), duplicates dropped, the order kept
-    from cadgen.optimize.run import _rounded
+    from cadgen.optimize.finals import rounded as _rounded
 
     high = low + width
     column = np.clip(np.asarray(values), low, high)

@@ -195,8 +195,9 @@ def test_two_thousand_points_build_their_curve_and_its_checks_quickly():
     started = time.perf_counter()
     curve = ClosedCurve(points, 5)
     assert curve.centre_problems((0.0, 0.0)) == []
-    # a structural bound, not a benchmark: all pairs of this polyline would take minutes
-    assert time.perf_counter() - started < 20.0
+    # a structural bound, not a benchmark: all pairs of this polyline would take minutes (it
+    # takes seconds, under a minute on a 2-core machine with the other core busy)
+    assert time.perf_counter() - started < 60.0
     # and a figure-of-eight of 2000 points is still caught, where it crosses
     t = np.linspace(0.0, 2 * np.pi, 2000, endpoint=False)
     eight = np.c_[100 * np.sin(t), 60 * np.sin(2 * t) - 200]

@@ -16,7 +16,6 @@ for a time.
 """
 
 import re
-import time
 from pathlib import Path
 
 import pytest
@@ -49,7 +48,6 @@ def reports(tmp_path_factory, chromium):
 
 @pytest.mark.parametrize("design", ["xin2024-planter", "kernel-a"], ids=["planting", "pricking"])
 def test_report_renders_and_moves_in_chromium(browser, reports, design):
-    start = time.perf_counter()
     page, requests, errors = SHOTS.open_report(browser, reports[design], width=WIDTHS[0])
     try:
         found = SHOTS.page_report(page, wait_ms=600)
@@ -80,7 +78,6 @@ def test_report_renders_and_moves_in_chromium(browser, reports, design):
         page.close()
     assert not problems, "\n".join(problems)
     assert found["viewer"]["meshes"] >= 4
-    assert time.perf_counter() - start < 15
 
 
 # ---------------------------------------------------------------- the page's data, no browser

@@ -694,3 +694,24 @@ def test_the_studio_names_each_clearance_as_a_metrics_build_does():
     assert studio["arm_distance"] == built["arm_distance"] == "arm distance (centre lines)"
     assert studio["ground_clearance"] == built["ground_clearance"] == \
         "gearbox ground clearance (envelope circles)"
+
+
+def test_a_resolution_beyond_the_live_cap_is_evaluated_at_the_cap_and_said():
+    # 1,000,000 steps per revolution took 10 s an evaluation: the page evaluates at the fine
+    # preset's 36,000 and says so; the answer is the one 36,000 steps give
+    import tomllib
+
+    from cadgen.studio.payload import evaluate_request
+    from tests.helpers import reference_text
+
+    data = tomllib.loads(reference_text())
+    data["resolution"]["steps_per_revolution"] = 36_000
+    _, at_cap = evaluate_request(data)
+    data["resolution"]["steps_per_revolution"] = 1_000_000
+    status, answer = evaluate_request(data)
+    assert status == 200
+    [warning] = [w for w in answer["warnings"] if w["code"] == "capped_for_live_evaluation"]
+    assert warning["path"] == "resolution.steps_per_revolution"
+    assert "1,000,000" in warning["message"] and "36,000" in warning["message"]
+    assert [m["value"] for m in answer["metrics"]] == [m["value"] for m in at_cap["metrics"]]
+    assert data["resolution"]["steps_per_revolution"] == 1_000_000   # the page's own data

@@ -40,7 +40,6 @@ the run's exit code is 1.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -49,6 +48,8 @@ from typing import Any
 import numpy as np
 
 from cadgen.optimize.checks import BuildKnowledge
+from cadgen.optimize.finals import (FinalDesign, _natural, rounded, screened_rows,
+                                    variable_steps)
 from cadgen.optimize.problem import PopulationEvaluator, PymooProblem, make_problem
 
 __all__ = ["optimize_study", "OptimizeResult", "FinalDesign", "OptimizeProgress", "base_point",
@@ -107,54 +108,6 @@ class OptimizeProgress:
     total: int = 0
 
 
-@dataclass(eq=False)   # compared by identity: x is an array
-class FinalDesign:
-    """A certified design: its variables, the screen's figures and the exact ones."""
-
-    x: np.ndarray
-    screened: dict          # {"values", "margins", "objectives", "feasible", "violation"}
-    exact: dict             # problem.certify(x)
-    role: str = ""          # "best", "front", "candidate", "base"
-
-    @property
-    def passed(self) -> bool:
-        """Every target met by the exact path, no build stage refuses the design, and
-        every check of a metrics + cam + drivetrain build passes."""
-        return (bool(self.exact.get("passed")) and not self.exact.get("stage_problems")
-                and not self.exact.get("build_failures"))
-
-    @property
-    def min_margin(self) -> float | None:
-        """The exact smallest normalised margin: the problem's ``min_margin`` when it gives
-        one (planting leaves out a met ``= 1`` target, whose margin is 0 at best), else the
-        smallest exact margin."""
-        value = self.exact.get("values", {}).get("min_margin")
-        if _is_real(value):
-            return float(value)
-        margins = [m for m in self.exact.get("margins", {}).values() if _is_real(m)]
-        return min(margins) if margins else None
-
-    @property
-    def exact_violation(self) -> float:
-        """Sum of the negative exact margins (0 when every margin holds); inf if refused."""
-        if self.exact.get("problems"):
-            return float("inf")
-        margins = np.array([m for m in self.exact.get("margins", {}).values()
-                            if m is not None and np.isfinite(m)], dtype=float)
-        return float(-np.minimum(margins, 0.0).sum()) + 0.0 if margins.size else float("inf")
-
-    def differences(self) -> dict:
-        """``exact - screened`` of every value and margin both give."""
-        out = {}
-        for group in ("values", "margins"):
-            screened, exact = self.screened.get(group, {}), self.exact.get(group, {})
-            for key in screened:
-                a, b = screened[key], exact.get(key)
-                if _is_real(a) and _is_real(b):
-                    out[f"{group[:-1]}:{key}" if group == "margins" else key] = float(b) - float(a)
-        return out
-
-
 @dataclass
 class OptimizeResult:
     """Everything a study's run found (written by :mod:`cadgen.optimize.outputs`)."""
@@ -192,11 +145,6 @@ class OptimizeResult:
     def chosen(self) -> FinalDesign | None:
         """The design best.toml holds: the best, else the least violating."""
         return self.best or self.least_violating
-
-
-def _is_real(value) -> bool:
-    return isinstance(value, (int, float, np.floating)) and not isinstance(value, bool) and \
-        np.isfinite(value)
 
 
 def population_size(budget: int) -> int:
@@ -321,59 +269,6 @@ class _Archive:
                 "objectives": objectives,
                 "feasible": bool(a["valid"][index] and np.all(G <= 0.0)),
                 "violation": float(np.maximum(G, 0.0).sum())}
-
-
-def _natural(value: float, sense: str) -> float:
-    return -value if sense == "max" else value
-
-
-def _screened(problem, X: np.ndarray) -> list[dict]:
-    """The screen's figures of each row of ``X`` (as :meth:`_Archive.screened` gives them)."""
-    screened = problem.evaluate(np.atleast_2d(np.asarray(X, dtype=float)))
-    out = []
-    for row in range(len(X)):
-        G = np.asarray(screened["G"][row], dtype=float)
-        F = np.asarray(screened["F"][row], dtype=float)
-        out.append({
-            "values": {k: float(np.asarray(v)[row]) for k, v in screened["values"].items()},
-            "margins": dict(zip(problem.constraint_labels, (-G).tolist())),
-            "objectives": {key: _natural(float(f), sense)
-                           for (key, sense), f in zip(problem.objectives, F)},
-            "feasible": bool(np.asarray(screened["valid"])[row] and np.all(G <= 0.0)),
-            "violation": float(np.maximum(G, 0.0).sum())})
-    return out
-
-
-def _variable_steps(study, problem) -> np.ndarray:
-    """Each variable's rounding step (0: not rounded): the study's steps by free path; a
-    pricking study's displacements all take its points' step."""
-    steps = getattr(study, "steps", None) or {}
-    if getattr(study, "kind", None) == "pricking":
-        return np.full(len(problem.variables), steps.get("trajectory.points", 0.0))
-    return np.array([steps.get(name, 0.0) for name in problem.variables], dtype=float)
-
-
-def _decimals(step: float) -> int:
-    """The decimals that write ``step`` exactly (0.01 -> 2, 0.25 -> 2, 0.5 -> 1, 2 -> 0)."""
-    return next((d for d in range(13) if round(step, d) == step), 12)
-
-
-def _rounded(X: np.ndarray, steps: np.ndarray, lower, upper) -> np.ndarray:
-    """The rows of ``X`` with each column rounded to its step within its bounds (a value
-    rounded out of them takes the nearest step inside), duplicates after rounding dropped
-    (first kept: the order is best first). A step of 0 leaves the column as it is."""
-    X = np.array(X, dtype=float, ndmin=2)
-    for j, step in enumerate(np.asarray(steps, dtype=float)):
-        if step > 0:
-            low = math.ceil(lower[j] / step - 1e-9) * step
-            high = math.floor(upper[j] / step + 1e-9) * step
-            column = np.clip(np.round(X[:, j] / step) * step, low, high)
-            X[:, j] = np.round(column, _decimals(step))   # 188.99, not 188.99000000000001
-    _, first = np.unique(X, axis=0, return_index=True)
-    return X[np.sort(first)]
-
-
-# --------------------------------------------------------------------------- selection
 
 
 def _unique_rows(X: np.ndarray, order: np.ndarray) -> np.ndarray:
@@ -570,14 +465,14 @@ def optimize_study(study, *, workers: int = 1, scheduler: str | None = None,
         finals: list[FinalDesign] = []
         # the designs certified are the ones a workshop is given: rounded to the study's
         # steps (0.01 mm...), screened again and certified as rounded
-        candidates = _rounded(archive.arrays()["X"][rows], _variable_steps(study, problem),
+        candidates = rounded(archive.arrays()["X"][rows], variable_steps(study, problem),
                               lower, upper) if rows else np.zeros((0, len(lower)))
         batch = list(range(min(len(candidates), max_certified if len(objectives) > 1
                                else min(CERTIFY_FIRST, max_certified))))
         total = len(batch)
         while batch:
             exact = evaluator.certify([candidates[k] for k in batch])
-            screened = _screened(problem, candidates[batch])
+            screened = screened_rows(problem, candidates[batch])
             for k, shown, result in zip(batch, screened, exact):
                 finals.append(FinalDesign(np.array(candidates[k]), shown, result))
                 report("certify", generation, len(finals), total)
@@ -590,7 +485,7 @@ def optimize_study(study, *, workers: int = 1, scheduler: str | None = None,
         base_design = None
         if np.all(np.isfinite(base)):
             [base_exact] = evaluator.certify([base])
-            base_design = FinalDesign(base, _screened(problem, base[None, :])[0], base_exact,
+            base_design = FinalDesign(base, screened_rows(problem, base[None, :])[0], base_exact,
                                       role="base")
         certify_seconds = time.perf_counter() - certify_started
         where = evaluator.describe()

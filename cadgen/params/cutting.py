@@ -212,8 +212,10 @@ class CuttingParameters(_Table):
     chord_tolerance: float = Field(0.005, gt=0, le=1,
                                    description="largest deviation of the DXF polyline from the profile, mm")
     bore_diameter: float = Field(0.0, ge=0, description="shaft bore of every gear, mm (0: none)")
+    # at most 4000: each pose costs about 6 ms of the teeth stage on the paper's 22-tooth
+    # pair (16000 poses took 100 s against 1.8 s at the default; benchmarks/knob_costs.py)
     meshing_poses: int | None = Field(
-        None, ge=16, le=20000,
+        None, ge=16, le=4000,
         description="poses of the meshing check over one cycle (default 8 per tooth, at least 96)")
     circular_module: float | None = Field(
         None, gt=0, description="module of the trains' circular gears, mm (default: the largest "

@@ -52,7 +52,8 @@ def design_problems(params) -> list:
     problems = pair_problems(closure, module)
     if problems:
         return problems
-    problems = shift_problems(params, planting_circular_sizes(params, mechanism))
+    problems = _module_problems(params, module)
+    problems += shift_problems(params, planting_circular_sizes(params, mechanism))
     if problems:
         return problems
     from cadgen.design import planting_events
@@ -65,6 +66,36 @@ def design_problems(params) -> list:
     except DesignError as error:   # no events: no cam timing to check
         return list(error.problems) + _cam_problems(params, mechanism, None)
     return _cam_problems(params, mechanism, events)
+
+
+#: A module below this fraction of ``targets.module_min`` fails the target so plainly that
+#: cutting the gears is pointless: a build that cuts them refuses the design, before it cuts.
+FAR_BELOW_MODULE_TARGET = 0.5
+
+
+def _module_problems(params, module: float) -> list:
+    """``module_far_below_target`` (stage teeth) when the non-circular module is less than
+    half its target: the metrics report the failed target either way, and a build that cuts
+    the teeth would spend its time (a thousand teeth of a tenth of a millimetre, say) on
+    gears that cannot be used. Names the tooth count that meets the target."""
+    import math
+
+    target = params.targets.module_min
+    if target is None or not module < FAR_BELOW_MODULE_TARGET * target:
+        return []
+    teeth = params.pitch_curve.teeth
+    perimeter = module * math.pi * teeth
+    fits = math.floor(perimeter / (math.pi * target) + 1e-9)
+    advice = (f"pitch_curve.teeth = {fits} or fewer gives a module of "
+              f"{perimeter / (math.pi * fits):.3f} mm" if fits >= 6 else
+              "no tooth count of at least 6 reaches it on this pitch curve")
+    return [Problem("pitch_curve.teeth", "module_far_below_target",
+                    f"{teeth} teeth on the {perimeter:.1f} mm pitch curve are a module of "
+                    f"{module:.4g} mm, less than half the {target:g} mm target "
+                    f"(targets.module_min): gears this fine fail it however they are cut, so "
+                    f"a build that cuts them refuses the design before cutting; {advice}, or "
+                    "lower targets.module_min",
+                    stage="teeth")]
 
 
 def _cam_problems(params, mechanism, events) -> list:

@@ -73,7 +73,10 @@ class GroundParameters(_Table):
 class SolidsParameters(_Table):
     """Mesh resolution, material and assembly pose of the solids."""
 
-    segments_per_circle: int = Field(96, ge=8, le=4096,
+    # at most 1024: the FCL sweeps grow faster than the facets (the paper design's
+    # full build, one process: 96 facets 7.5 s, 384 15 s, 768 22 s, 1536 67 s: nine times
+    # the usual; benchmarks/knob_costs.py), and 1024 facets keep a 300 mm circle within 0.0015 mm
+    segments_per_circle: int = Field(96, ge=8, le=1024,
                                      description="facets of a full circle (bores, shells, tubes)")
     density_kg_m3: float | None = Field(
         None, gt=0, description="density of every made part for the mass properties, kg/m^3 "
