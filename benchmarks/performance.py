@@ -10,7 +10,7 @@ Run:  python -m benchmarks.performance [--output docs/performance.md] [--quick]
    interpreter, whole process, imports included) with the gear cache cold (emptied
    before the run), the same with the cache warm (the cold run's entries), and the
    metrics-only scene (``--effects metrics``). Medians, spreads (min-max) and the ratio
-   of each median to the peer's. Issue 15's aims: the cold full build <= 0.35 x the
+   of each median to the peer's. The aims: the cold full build <= 0.35 x the
    peer (0.25 x hoped), metrics only <= 0.05 x. The benchmark's gear cache is a temporary
    directory (``CADGEN_CACHE_DIR``), never the user's. The stage times of the last cold
    and warm builds are printed as a second table.
@@ -305,7 +305,8 @@ def main(argv=None):
              "generating and verifying ONE 24-tooth pair from its command line "
              "(`python -m ncgears --centrode \"30 + 8*cos(phi)\" --teeth 24 --module 2.5`); "
              "our build cuts, checks and meshes five pairs and does everything else. "
-             "Issue 15's aims: cold full build <= 0.35 x the peer, metrics only <= 0.05 x. "
+             "The aims: cold full build <= 0.35 x the peer, metrics only <= 0.05 x "
+             "(docs/benchmarks.md says why they are not met). "
              "CPU: user and system time of the command and the worker it forks, median.", "",
              "| command | median (s) | spread (s) | x peer (medians) | x peer, each round "
              "(min-max) | aim | CPU (s) |",
@@ -345,7 +346,7 @@ def main(argv=None):
         lines += ["", "## Accuracy presets", "",
                   "The full build of the paper's design, every effect, gear cache cold, at "
                   "each `--preset` (three interleaved runs each, median; the knobs each sets "
-                  "are in the README and cadgen/params/scene.py).", "",
+                  "are in docs/guide.md and cadgen/params/scene.py).", "",
                   "| preset | median (s) | spread (s) | CPU (s) |", "|---|---:|---:|---:|"]
         lines += [f"| {preset} | {wall:.2f} | {spread} | {used:.2f} |"
                   for preset, wall, spread, used in presets]
@@ -353,7 +354,8 @@ def main(argv=None):
         lines += ["", "## What each effect costs", "",
                   "The paper's design, gear cache cold, each scene adding effects to the one "
                   "above (`--effects`; five interleaved runs, median). A scene runs only the "
-                  "stages its effects need (README, \"Scenes\"); the second core works beside "
+                  "stages its effects need (docs/guide.md, \"Scenes\"); the second core works "
+                  "beside "
                   "the teeth once parts, sweeps or figures follow them.", "",
                   "| scene | median (s) | spread (s) | added (s) | CPU (s) |",
                   "|---|---:|---:|---:|---:|"]
@@ -368,7 +370,7 @@ def main(argv=None):
                   "Each worker imports what its designs' builds will before forking the first "
                   "(`cadgen.pipeline.warm`); with a design on every core each build keeps to "
                   "its process (`parallel=False`). The last row is the same batch with each "
-                  "build forking its worker beside its teeth, as before, through the library "
+                  "build forking its worker beside its teeth, through the library "
                   "in the same run.", "",
                   "| batch | workers | designs | wall (s) | designs per minute | x 1 worker |",
                   "|---|---:|---:|---:|---:|---:|"]

@@ -97,7 +97,7 @@ def tables_with(base, change):
     return tables
 
 
-@settings(max_examples=200, deadline=None, derandomize=True,
+@settings(max_examples=80, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(change=designs())
 def test_screen_matches_the_exact_evaluator(base_tables, change):

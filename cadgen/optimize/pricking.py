@@ -148,19 +148,18 @@ class PrickingProblem:
         return x
 
     def points_at(self, x) -> np.ndarray:
-        """The type-value points with the displacements ``x`` applied, (m, 2) mm."""
+        """The type-value points with the displacements ``x`` applied, (m, 2) mm, to 1e-9 mm:
+        a file holds a point as a person writes it (-3.14, not the -3.1399999999999997 that
+        -5.0 + 1.86 gives), and the screen and the exact path read the same points."""
         x = self._checked(x)
         points = self._base_points.copy()
         points[self._moved] += x.reshape(-1, 2)
-        return points
+        return np.round(points, 9)
 
     def tables_at(self, x) -> dict:
         """The base design's tables (every value, as a file would hold it) with ``x`` applied."""
         tables = copy.deepcopy(self.base_params.model_dump(mode="json", exclude_none=True))
-        # to 1e-9 mm: the base point plus a rounded displacement, written as a person would
-        # (-3.14, not -3.1399999999999997)
-        tables["trajectory"]["points"] = [[round(float(px), 9), round(float(py), 9)]
-                                          for px, py in self.points_at(x)]
+        tables["trajectory"]["points"] = [[float(px), float(py)] for px, py in self.points_at(x)]
         return tables
 
     def _screen_params(self, x):
@@ -199,7 +198,7 @@ class PrickingProblem:
         values["forward_margin"] = (FORWARD_TOLERANCE - forward_deviation) / FORWARD_TOLERANCE
         values["min_margin"] = min(values["convexity"], values["ratio_margin"],
                                    values["forward_margin"])
-        moves = np.asarray(x, dtype=float).reshape(-1, 2)
+        moves = self.points_at(x) - self._base_points   # as written: to 1e-9 mm
         values["displacement"] = float(np.hypot(moves[:, 0], moves[:, 1]).max())
         values["_normalised"] = normalised
         return values
