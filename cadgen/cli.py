@@ -463,9 +463,15 @@ def entry() -> None:
 
     status = main()
     processes = sys.modules.get("multiprocessing")   # never imported: no child to wait for
-    if (processes is not None and processes.active_children()) or any(
-            not t.daemon for t in threading.enumerate() if t is not threading.main_thread()):
+    shutdown = getattr(threading, "_shutdown", None)
+    if (processes is not None and processes.active_children()) or shutdown is None:
         raise SystemExit(status)
+    # What the interpreter's exit does first: wait for every non-daemon thread to end, to
+    # its very end (a process pool's manager thread finalises the pool's semaphores as its
+    # last act, after threading.enumerate() has stopped listing it: cut short there, one is
+    # unlinked but not unregistered, and the resource tracker warns of a leak), and run
+    # the exit handlers threads registered (concurrent.futures' joins its pools' threads)
+    shutdown()
     atexit._run_exitfuncs()
     try:
         sys.stdout.flush()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import os
 import pickle
@@ -83,7 +84,8 @@ def _collect(futures: Mapping, finished: Iterable, on_result) -> list[dict]:
     summaries = []
     for future in finished:
         try:
-            summary = future.result()
+            with sigint_deferred():   # (the future's lock: see _completed)
+                summary = future.result()
         except Exception as exc:  # the job did not return: BrokenProcessPool, KilledWorker
             summary = _summary(futures[future], time.perf_counter(),
                                failure=_exception_failure(exc, "worker_error"))
@@ -110,15 +112,19 @@ def _completed(futures, submitted, starts, on_start, ready: set):
     pending, told = set(futures), set()
     running = {}    # worker pid -> the future of the design it runs
     while pending:
-        done, pending = wait(pending, timeout=_START_POLL_SECONDS, return_when=FIRST_COMPLETED)
-        while not starts.empty():
-            pid, number = starts.get()
-            if number == _READY:
-                ready.add(pid)
-                continue
+        # Ctrl-C is held back while this thread holds the pool's locks: wait() takes every
+        # pending future's lock in a loop, and an interrupt raised halfway through leaves
+        # some held for good (the pool's manager thread then blocks on one, and so does the
+        # interpreter's exit, which joins it); the interrupt comes as the block ends
+        with sigint_deferred():
+            done, pending = wait(pending, timeout=_START_POLL_SECONDS,
+                                 return_when=FIRST_COMPLETED)
+            started = _drain(starts, ready)
+        for pid, number in started:
             previous = running.get(pid)
             if previous is not None and previous not in told:
-                wait([previous])
+                with sigint_deferred():
+                    wait([previous])
                 pending.discard(previous)
                 done.discard(previous)
                 told.add(previous)
@@ -129,6 +135,19 @@ def _completed(futures, submitted, starts, on_start, ready: set):
         for future in done:
             told.add(future)
             yield future
+
+
+def _drain(starts, ready: set) -> list[tuple[int, int]]:
+    """The ``(worker pid, design number)`` starts told on ``starts`` since last asked; each
+    worker that tells it is ready is added to ``ready`` instead."""
+    started = []
+    while not starts.empty():
+        pid, number = starts.get()
+        if number == _READY:
+            ready.add(pid)
+        else:
+            started.append((pid, number))
+    return started
 
 
 def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
@@ -144,7 +163,7 @@ def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
         # started first: starting it unblocks SIGINT in this thread (its own guard), which
         # would end the block below as soon as the pool made its first semaphore
         resource_tracker.ensure_running()
-    pool, futures, submitted, ready = None, {}, [], set()
+    pool, starts, futures, submitted, ready = None, None, {}, [], set()
     try:
         # the workers are started by submit(), with SIGINT held back until their handler is in
         # place (a Ctrl-C while one still imports would print its traceback), and the pool's
@@ -168,6 +187,12 @@ def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
             future.cancel()
         if pool is not None:
             _stop_workers(pool, starts, ready)
+        # The pool's semaphores are finalised here, in an except clause, where no interrupt
+        # is raised again (cadgen.processes.Interrupts), not as the exception leaves this
+        # frame: a repeated interrupt landing between a semaphore's unlinking and its
+        # unregistering made the resource tracker warn of a leak at exit.
+        pool = starts = None
+        gc.collect()
         raise
     pool.shutdown()
     return summaries
@@ -195,10 +220,7 @@ def _stop_workers(pool, starts, ready: set, grace: float = _STOP_GRACE_SECONDS) 
         with contextlib.suppress(OSError, ValueError):
             os.kill(process.pid, signal.SIGINT)
     with contextlib.suppress(OSError, EOFError, ValueError):
-        while not starts.empty():
-            pid, number = starts.get()
-            if number == _READY:
-                ready.add(pid)
+        _drain(starts, ready)
     for process in processes:
         if process.pid not in ready:
             with contextlib.suppress(OSError, ValueError):

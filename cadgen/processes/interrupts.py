@@ -38,6 +38,10 @@ __all__ = ["Interrupts", "REPEAT_SECONDS", "EXIT_INTERRUPTED", "sigint_deferred"
 EXIT_INTERRUPTED = 128 + signal.SIGINT
 #: How often an interrupt that did not stop the command is raised again (s).
 REPEAT_SECONDS = 0.1
+#: How many :func:`sigint_deferred` blocks are open: while one is, the handler only remembers
+#: an interrupt (a signal blocked in the main thread may still be taken by another thread,
+#: whose Python handler then runs in the main thread), and the watchdog raises it after.
+_DEFERRING = [0, False]   # [blocks open, an interrupt remembered meanwhile]
 
 
 class Interrupts:
@@ -84,7 +88,8 @@ class Interrupts:
         self._lock = threading.RLock()
 
     def _raising(self) -> bool:
-        return not self.stopping and (self._active is None or bool(self._active()))
+        return (not self.stopping and not _DEFERRING[0]
+                and (self._active is None or bool(self._active())))
 
     # -- the handler, in the main thread
     def _handle(self, signum, frame):
@@ -93,7 +98,11 @@ class Interrupts:
         self.seen = True
         self.signal = self.signal or signum
         self._watch()
-        if self._raising() and sys.exc_info()[1] is None:   # else unwinding: let it
+        if _DEFERRING[0] and not self.stopping:
+            _DEFERRING[1] = True   # raised as the block ends (sigint_deferred)
+        elif (self._raising() and sys.exc_info()[1] is None   # else unwinding: let it
+              and not _initialising_extension(frame)):   # else the watchdog's next try
+            _DEFERRING[1] = False
             raise KeyboardInterrupt
 
     def _unraisable(self, unraisable):
@@ -156,6 +165,25 @@ class Interrupts:
         return False
 
 
+def _initialising_extension(frame) -> bool:
+    """Whether ``frame`` runs inside the initialisation of a compiled extension module.
+
+    An extension built with pybind11 or nanobind (manifold3d, say) may run Python code as it
+    initialises (importing numpy); an exception raised there, an interrupt included, cannot
+    leave the C++ initialiser, and the process aborts ("terminate called after throwing an
+    instance of 'nanobind::python_error'"). Seen from Python, such code runs below the
+    import system's ``create_module`` or ``exec_module`` of an ``ExtensionFileLoader``.
+    """
+    while frame is not None:
+        code = frame.f_code
+        if (code.co_name in ("create_module", "exec_module")
+                and code.co_filename.startswith("<frozen importlib")
+                and type(frame.f_locals.get("self")).__name__ == "ExtensionFileLoader"):
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _take_pending_signals() -> None:
     """A Python call: the interpreter runs the handlers of signals pending in this thread
     at a call's start (its eval breaker)."""
@@ -176,16 +204,23 @@ def sigint_deferred() -> Iterator[None]:
     A child started meanwhile (fork, or fork and exec) inherits the block: a Ctrl-C that
     reaches it before it has installed its handler stays pending until it calls
     :func:`release_deferred_sigint`. This thread's own pending SIGINT is delivered when
-    the block ends. Does nothing where signals cannot be blocked (not POSIX).
+    the block ends; one that another thread took meanwhile is remembered by
+    :class:`Interrupts` and raised by its watchdog once the block has ended (so nothing the
+    block makes is left half made: a semaphore registered but never given its finaliser
+    leaks). The blocking does nothing where signals cannot be blocked (not POSIX).
     """
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    blocking = hasattr(signal, "pthread_sigmask")
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocking else None
+    _DEFERRING[0] += 1   # (a signal another thread takes runs the handler here all the same)
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        _DEFERRING[0] -= 1
+        if blocking:   # this thread's pending SIGINT is handled here, raising
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        if _DEFERRING[1] and not _DEFERRING[0]:   # one taken by another thread meanwhile
+            _DEFERRING[1] = False
+            raise KeyboardInterrupt
 
 
 def release_deferred_sigint() -> None:
