@@ -140,3 +140,56 @@ def test_staged_directory_refuses_a_file(tmp_path):
         with staged_directory(final):
             pass  # pragma: no cover
     assert final.read_text() == "not a directory"
+
+
+@pytest.mark.skipif(not hasattr(os, "kill"), reason="signals")
+@pytest.mark.parametrize("moment", ["made", "swapped"])
+def test_ctrl_c_as_the_staging_folder_is_made_or_swapped_leaves_no_stray_folder(
+        moment, tmp_path, monkeypatch):
+    # the signal arrives the instant the folder exists (inside mkdtemp) or the instant the
+    # swap is done: raised there, it would leave a folder nobody knows of, or roll back a
+    # swap half way; held back, it comes once the folder is named or the swap is whole
+    import signal
+    import tempfile
+
+    from cadgen.processes import Interrupts
+
+    final = tmp_path / "design"
+    final.mkdir()
+    (final / "old.txt").write_text("old")
+    real_mkdtemp, real_replace = tempfile.mkdtemp, os.replace
+
+    def mkdtemp(*args, **kwargs):
+        made = real_mkdtemp(*args, **kwargs)
+        if moment == "made" and ".staging-" in made:
+            os.kill(os.getpid(), signal.SIGINT)
+        return made
+
+    def replace(source, target):
+        real_replace(source, target)
+        if moment == "swapped" and str(target) == str(final):
+            os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(tempfile, "mkdtemp", mkdtemp)
+    monkeypatch.setattr(os, "replace", replace)
+    wrote = []
+    # handled as in a terminal's foreground job (a suite run in the background ignores it)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with Interrupts(signals=(signal.SIGINT,)) as interrupts:
+            with pytest.raises(KeyboardInterrupt):
+                with staged_directory(final) as staging:
+                    (staging / "new.txt").write_text("new")
+                    wrote.append(True)
+                for _ in range(10 ** 7):   # (not reached when the interrupt came in the block)
+                    pass
+            interrupts.stopping = True
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert interrupts.seen
+    if moment == "made":   # interrupted before the block ran: the old outputs, untouched
+        assert not wrote and _names(tmp_path) == ["design"]
+        assert _names(final) == ["old.txt"]
+    else:                  # the swap is whole: the new outputs, nothing stray beside them
+        assert wrote and _names(tmp_path) == ["design"]
+        assert _names(final) == ["new.txt"]

@@ -224,10 +224,12 @@ def test_ctrl_c_during_a_build_leaves_nothing(moment, after, tmp_path):
     assert code == 130, stderr[-3000:]
     _no_traceback_and_one_line(stderr)
     left = sorted(p.name for p in out.iterdir()) if out.exists() else []
-    if re.search(r"write: ok", stderr):    # the signal came as the folder was swapped in
-        assert left == ["xin2024-planter"] and (out / left[0] / "report.json").is_file()
+    if left:   # the signal came as the folder was swapped in (the commit): it is whole
+        assert left == ["xin2024-planter"], left   # no staging folder, no retired one
+        report = json.loads((out / left[0] / "report.json").read_text(encoding="utf-8"))
+        assert all((out / left[0] / file).is_file() for file in report["files"])
     else:
-        assert left == [], left   # no folder, no staging folder
+        assert not re.search(r"write: ok", stderr), stderr   # written, then lost?
 
 
 GRID = ROOT / "params" / "grids" / "l2-sweep.toml"

@@ -219,25 +219,38 @@ def staged_directory(final_dir: str | os.PathLike) -> Iterator[Path]:
     final_dir = Path(final_dir)
     if final_dir.exists() and not final_dir.is_dir():
         raise NotADirectoryError(f"{final_dir} exists and is not a directory")
+    from cadgen.processes import sigint_deferred
+
     final_dir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.staging-"))
+    staging = None
     try:
+        # made and named at once: a Ctrl-C between the two would leave a folder nobody removes
+        with sigint_deferred():
+            staging = Path(tempfile.mkdtemp(dir=final_dir.parent,
+                                            prefix=f".{final_dir.name}.staging-"))
         yield staging
+        # mkdtemp makes the directory 0o700; give it the mode mkdir() would.
+        os.chmod(staging, 0o777 & ~_current_umask())
     except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
         raise
-    # mkdtemp makes the directory 0o700; give it the mode mkdir() would.
-    os.chmod(staging, 0o777 & ~_current_umask())
-    retired = None
+    retired, swapped = None, False
     try:
-        if final_dir.exists():
-            retired = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.old-"))
-            os.replace(final_dir, retired / final_dir.name)
-        os.replace(staging, final_dir)
+        # the swap is the commit: done whole, a Ctrl-C meanwhile comes after it (the outputs
+        # are then complete, in place, and the command still says it was interrupted)
+        with sigint_deferred():
+            if final_dir.exists():
+                retired = Path(tempfile.mkdtemp(dir=final_dir.parent,
+                                                prefix=f".{final_dir.name}.old-"))
+                os.replace(final_dir, retired / final_dir.name)
+            os.replace(staging, final_dir)
+            swapped = True
     except BaseException:
-        if retired is not None and (retired / final_dir.name).exists():
-            os.replace(retired / final_dir.name, final_dir)
-        shutil.rmtree(staging, ignore_errors=True)
+        if not swapped:
+            if retired is not None and (retired / final_dir.name).exists():
+                os.replace(retired / final_dir.name, final_dir)
+            shutil.rmtree(staging, ignore_errors=True)
         if retired is not None:
             shutil.rmtree(retired, ignore_errors=True)
         raise

@@ -199,7 +199,8 @@ def _handling(thread: int) -> BaseException | None:
 
 @contextmanager
 def sigint_deferred() -> Iterator[None]:
-    """Block SIGINT in this thread while child processes are started in it.
+    """Hold Ctrl-C back in this thread while the block runs: a block that must be done
+    whole or not at all (child processes started, a folder made and named, a swap).
 
     A child started meanwhile (fork, or fork and exec) inherits the block: a Ctrl-C that
     reaches it before it has installed its handler stays pending until it calls
@@ -207,18 +208,22 @@ def sigint_deferred() -> Iterator[None]:
     the block ends; one that another thread took meanwhile is remembered by
     :class:`Interrupts` and raised by its watchdog once the block has ended (so nothing the
     block makes is left half made: a semaphore registered but never given its finaliser
-    leaks). The blocking does nothing where signals cannot be blocked (not POSIX).
+    leaks). The blocking does nothing where signals cannot be blocked (not POSIX). In a
+    thread other than the main one (where Python raises no interrupt) it only blocks.
     """
     blocking = hasattr(signal, "pthread_sigmask")
+    main = threading.current_thread() is threading.main_thread()
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocking else None
-    _DEFERRING[0] += 1   # (a signal another thread takes runs the handler here all the same)
+    if main:   # (a signal another thread takes runs the handler here all the same)
+        _DEFERRING[0] += 1
     try:
         yield
     finally:
-        _DEFERRING[0] -= 1
+        if main:
+            _DEFERRING[0] -= 1
         if blocking:   # this thread's pending SIGINT is handled here, raising
             signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-        if _DEFERRING[1] and not _DEFERRING[0]:   # one taken by another thread meanwhile
+        if main and _DEFERRING[1] and not _DEFERRING[0]:   # one another thread took meanwhile
             _DEFERRING[1] = False
             raise KeyboardInterrupt
 
