@@ -35,8 +35,9 @@ ALLOWED = {
     "cadgen.design": {"kinematics", "cadgen.solids"},
     "cadgen.sweep": {"kinematics", "cadgen.solids"},
     "cadgen.params.feasibility": {"kinematics", "cadgen.params", "cadgen.design", "cadgen.cam"},
+    # (cadgen.processes: a staged folder is made and swapped in with Ctrl-C held back)
     "cadgen.export": {"kinematics", "cadgen.geometry", "cadgen.gears", "cadgen.solids",
-                      "cadgen.machine"},
+                      "cadgen.machine", "cadgen.processes"},
     "cadgen.report": {"kinematics", "cadgen", "cadgen.cam", "cadgen.export", "cadgen.gears",
                       "cadgen.solids", "cadgen.machine"},
     "cadgen.pipeline": {"kinematics", "cadgen.params", "cadgen.params.feasibility",
