@@ -10,6 +10,7 @@ that swallows KeyboardInterrupt (trimesh's ``except BaseException`` around its i
 
 from __future__ import annotations
 
+import ast
 import json
 import os
 import re
@@ -382,6 +383,28 @@ def test_an_interrupt_another_thread_takes_inside_a_deferred_block_comes_at_its_
     assert steps == list(range(10)) and interrupts.seen
 
 
+@POSIX
+def test_an_idle_process_only_remembers_an_interrupt_taken_in_a_deferred_block():
+    # an idle batch worker (active() false) remembers a Ctrl-C and starts no further design;
+    # the block's end must not raise it either
+    waiting = threading.Event()
+    other = threading.Thread(target=waiting.wait, args=(5,), daemon=True)
+    other.start()
+    raised = False
+    with Interrupts(active=lambda: False) as interrupts:
+        try:
+            with sigint_deferred():
+                signal.pthread_kill(other.ident, signal.SIGINT)
+                for _ in range(10):
+                    time.sleep(0.01)
+            time.sleep(3 * interrupts.repeat_seconds)   # nor the watchdog after it
+        except KeyboardInterrupt:
+            raised = True
+        interrupts.stopping = True
+    waiting.set()
+    assert interrupts.seen and not raised
+
+
 #: In a fresh interpreter: _decimal's initialiser imports numbers (Python code run from the
 #: extension's init, as manifold3d's imports numpy); a SIGINT sent there must wait for the
 #: import's end (raised in a pybind11/nanobind initialiser it aborts the process).
@@ -428,4 +451,5 @@ def test_an_interrupt_inside_an_extension_modules_initialiser_comes_after_it():
     outcome, seen = result.stdout.splitlines()
     assert outcome == "interrupted imported"
     # the import of _decimal itself is not inside an initialiser; numbers' is
-    assert ("_decimal", False) in eval(seen) and ("numbers", True) in eval(seen)
+    seen = ast.literal_eval(seen)
+    assert ("_decimal", False) in seen and ("numbers", True) in seen

@@ -99,7 +99,8 @@ class Interrupts:
         self.signal = self.signal or signum
         self._watch()
         if _DEFERRING[0] and not self.stopping:
-            _DEFERRING[1] = True   # raised as the block ends (sigint_deferred)
+            # raised as the block ends (sigint_deferred), if it would be raised now
+            _DEFERRING[1] = self._active is None or bool(self._active())
         elif (self._raising() and sys.exc_info()[1] is None   # else unwinding: let it
               and not _initialising_extension(frame)):   # else the watchdog's next try
             _DEFERRING[1] = False
@@ -206,9 +207,9 @@ def sigint_deferred() -> Iterator[None]:
     reaches it before it has installed its handler stays pending until it calls
     :func:`release_deferred_sigint`. This thread's own pending SIGINT is delivered when
     the block ends; one that another thread took meanwhile is remembered by
-    :class:`Interrupts` and raised by its watchdog once the block has ended (so nothing the
-    block makes is left half made: a semaphore registered but never given its finaliser
-    leaks). The blocking does nothing where signals cannot be blocked (not POSIX). In a
+    :class:`Interrupts` and raised here as the block ends (so nothing the block makes is
+    left half made: a semaphore registered but never given its finaliser leaks). The
+    blocking does nothing where signals cannot be blocked (not POSIX). In a
     thread other than the main one (where Python raises no interrupt) it only blocks.
     """
     blocking = hasattr(signal, "pthread_sigmask")
