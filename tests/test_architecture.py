@@ -27,6 +27,7 @@ ALLOWED = {
     # loading calls the design checks, inside a function (see cadgen.params.feasibility)
     "cadgen.params": {"kinematics", "cadgen.params.feasibility"},
     "cadgen.gears": {"kinematics"},
+    "cadgen.assembly": set(),        # the joint graph (standard library only)
     "cadgen.cam": {"kinematics"},
     # shafts, keys, bearings and fits: the machine-design rules (numbers and tables, no solids)
     "cadgen.machine": {"kinematics", "cadgen.params", "cadgen.geometry", "cadgen.gears"},
@@ -39,7 +40,7 @@ ALLOWED = {
     "cadgen.export": {"kinematics", "cadgen.geometry", "cadgen.gears", "cadgen.solids",
                       "cadgen.machine", "cadgen.processes"},
     "cadgen.report": {"kinematics", "cadgen", "cadgen.cam", "cadgen.export", "cadgen.gears",
-                      "cadgen.solids", "cadgen.machine"},
+                      "cadgen.solids", "cadgen.machine", "cadgen.assembly"},
     "cadgen.pipeline": {"kinematics", "cadgen.params", "cadgen.params.feasibility",
                         "cadgen.geometry", "cadgen.gears", "cadgen.cam", "cadgen.machine",
                         "cadgen.solids", "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report"},

@@ -27,7 +27,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from kinematics.errors import Problem
+from kinematics.errors import DesignError, Problem
 from kinematics.profile_shift import (MIN_PRACTICAL_MODULE, MIN_SHAPER_TEETH, MIN_TIP_THICKNESS,
                                       SHAPER_CLEARANCE, ModuleSetting, ShiftedGear,
                                       largest_unpointed_module, largest_unpointed_shift,
@@ -74,6 +74,14 @@ def planting_hints(mechanism, teeth: int, cutting) -> TrainHints:
     modules.update({name: ModuleSetting("gears.circular_module", module_c)
                     for name in ("gear D", "planet gear E", "sun", "idler 1", "idler 2",
                                  "train-1 planet")})
+    try:
+        from cadgen.gears.circular import holding_set_module
+
+        module_i = holding_set_module(mechanism, cutting.circular_module)
+        modules.update({name: ModuleSetting("gears.circular_module", module_i)
+                        for name in ("sun I", "idler 1-I", "idler 2-I", "planet I")})
+    except DesignError:   # the teeth stage says why set I cannot be cut
+        pass
     return TrainHints(modules, "the pitch_curve coefficients", cutting.pressure_angle_rad,
                       cutting.addendum, _given(cutting))
 

@@ -1,8 +1,9 @@
 """Every gear of a mechanism's trains: generated, phased, checked, meshed, drawn.
 
 Planting mechanism: gearbox 2's non-circular pair (central gear -> intermediate)
-and its 1:1 circular pair (D -> E), and train 1's set with converted ratio -1
-(sun -> idler 1 -> idler 2 -> planet). Pricking mechanism: stage 1 (sun ->
+and its 1:1 circular pair (D -> E), and train 1's two sets on the axes O, A, B, C
+(each sun -> idler -> idler -> planet: set II, converted ratio -2/(n - 1), carries
+gearbox 2; set I, -1/(n - 1), holds the central gear still). Pricking mechanism: stage 1 (sun ->
 first intermediate) and stage 2 (second intermediate -> planet). Every stage is
 phased at the mechanism's start position; a gear in two meshes is cut once.
 """
@@ -20,14 +21,15 @@ from kinematics.errors import DesignError
 from kinematics.profile_shift import shift_key
 
 from cadgen.gears.advice import advise_train, planting_hints, pricking_hints
-from cadgen.gears.circular import _radius_hint, circular_module, planting_circular_radii
+from cadgen.gears.circular import (TRAIN1_SETS, _radius_hint, circular_module, holding_set_module,
+                                   planting_circular_radii, planting_drive, train1_set_radii)
 from cadgen.gears.pairs import (FAILING_PROBLEMS, MIN_ROOT_THICKNESS, PitchPair, circle_pair,
                                 generate_pair)
 from cadgen.gears.meshing import meshing_check, relieve_interference
 from cadgen.gears.teeth import ToothSystem
 
 __all__ = ["GearStage", "GearTrain", "planting_pair", "planting_train", "pricking_train",
-           "train_report"]
+           "train_report", "set_report"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,9 @@ class GearTrain:
     stages: tuple
     failures: tuple = ()   # (stage name, Problem) for stages whose gears cannot be cut
     rims: tuple = ()       # cadgen.machine.hubs.RimCheck per gear, once bored for its shaft
+    # train 1's parallel sets (planting): their ratios and each mesh's axis distance
+    sets: tuple = ()       # ({"name", "key", "converted_ratio", "axes": (O, A, B, C)}, ...)
+    drive: object = None   # cadgen.gears.drive.DriveDesign of the frame's two pairs (planting)
     # the gear cache the train was cut with (or None): its files are looked up there too
     cache: object = field(default=None, repr=False, compare=False)
 
@@ -188,10 +193,10 @@ def _report_to(progress, total):
 def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     """The planting mechanism's gears at the catching position (phi = 0).
 
-    ``progress(done, total, pair name)``, optional, is called as each of the five pairs is cut.
+    ``progress(done, total, pair name)``, optional, is called as each of the ten pairs is cut.
     ``cache``, a :class:`~cadgen.gears.cache.GearCache` or None, answers pairs cut before.
     """
-    cut = _report_to(progress, 5)
+    cut = _report_to(progress, 10)
     cutting = params.gears
     shifts = _shift_table(cutting)
     a = mechanism.centre_distance
@@ -218,23 +223,44 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     cut(stages[-1].name)
     carrier = mechanism.phi0
     line = np.array([math.cos(carrier), math.sin(carrier)])
-    pair = circle_pair(("sun", "idler 1"), radii[0], radii[1])
-    first = _stage("train 1: sun to idler 1", pair, (z[0], z[1]), system, cutting,
-                   (carrier, np.zeros(2)), circular=True, cache=cache,
-                   shifts=_shifts(shifts, pair))
-    cut(first.name)
-    pair = circle_pair(("idler 1", "idler 2"), radii[1], radii[2])
-    second = _stage("train 1: idler 1 to idler 2", pair, (z[1], z[2]), system,
-                    cutting, (carrier, (radii[0] + radii[1]) * line), drive=_carry(first.generated),
-                    circular=True, cache=cache, shifts=_shifts(shifts, pair))
-    cut(second.name)
-    pair = circle_pair(("idler 2", "train-1 planet"), radii[2], radii[3])
-    third = _stage("train 1: idler 2 to planet", pair, (z[2], z[3]),
-                   system, cutting, (carrier, (radii[0] + 2 * radii[1] + radii[2]) * line),
-                   drive=_carry(second.generated), circular=True, cache=cache,
-                   shifts=_shifts(shifts, pair))
-    cut(third.name)
-    train = GearTrain(tuple(stages + [first, second, third]), cache=cache)
+    axes = [0.0] + [mechanism.carrier_radii[axis] for axis in ("A", "B", "C")]
+    sets = []
+    for key, set_name, _, names in TRAIN1_SETS:
+        if key == "II":
+            set_radii, set_system = radii[:4], system
+        else:
+            set_module = holding_set_module(mechanism, cutting.circular_module)
+            set_radii, set_system = train1_set_radii(mechanism, "I"), _system(cutting, set_module)
+        counts = [int(round(2 * x / set_system.module)) for x in set_radii]
+        drive = None
+        for k in range(3):
+            pair = circle_pair((names[k], names[k + 1]), set_radii[k], set_radii[k + 1])
+            stage = _stage(f"train 1 set {key}: {names[k]} to {names[k + 1]}", pair,
+                           (counts[k], counts[k + 1]), set_system, cutting,
+                           (carrier, axes[k] * line), drive=drive, circular=True, cache=cache,
+                           shifts=_shifts(shifts, pair))
+            stages.append(stage)
+            cut(stage.name)
+            drive = _carry(stage.generated)
+        ratio = (-2.0 if key == "II" else -1.0) / (mechanism.n - 1.0)
+        sets.append({"key": key, "name": set_name, "converted_ratio": ratio,
+                     "axes": ("O", "A", "B", "C"), "axis_distances": tuple(
+                         float(axes[k + 1] - axes[k]) for k in range(3)),
+                     "stages": tuple(s.name for s in stages[-3:])})
+    # the frame's drive: the input shaft turns the central shaft and carrier 1 the same way
+    drive = planting_drive(mechanism, module, cutting.circular_module,
+                           params.field.carrier_speed_rpm)
+    drive_system = _system(cutting, drive.module_1)
+    origin = np.array([-drive.centre_distance, 0.0])
+    for k, names in enumerate((("input gear 1", "central shaft gear"),
+                               ("input gear 2", "transmission driven gear"))):
+        pair = circle_pair(names, drive.radii[2 * k], drive.radii[2 * k + 1])
+        stage = _stage(f"drive: {names[0]} to {names[1]}", pair,
+                       (drive.teeth[2 * k], drive.teeth[2 * k + 1]), drive_system, cutting,
+                       (0.0, origin), circular=True, cache=cache, shifts=_shifts(shifts, pair))
+        stages.append(stage)
+        cut(stage.name)
+    train = GearTrain(tuple(stages), cache=cache, sets=tuple(sets), drive=drive)
     return advise_train(train, planting_hints(mechanism, teeth, cutting))
 
 
@@ -321,8 +347,38 @@ def train_report(train: GearTrain) -> dict:
     } for s in train.stages]
     failures = [{"stage": stage, "path": p.path, "code": p.code, "message": p.message}
                 for stage, p in train.failures]
-    return {"gears": gears, "meshes": meshes, "failures": failures,
-            "root_thickness_policy": ROOT_THICKNESS_POLICY}
+    out = {"gears": gears, "meshes": meshes, "failures": failures,
+           "root_thickness_policy": ROOT_THICKNESS_POLICY}
+    if train.sets:
+        out["sets"] = [set_report(train, record) for record in train.sets]
+    if train.drive is not None:
+        out["drive"] = train.drive.as_report()
+    return out
+
+
+def set_report(train: GearTrain, record: dict) -> dict:
+    """One of train 1's sets: its converted ratio (from the cut teeth: three external meshes,
+    ``-z_sun / z_planet``) against the one asked for, and each mesh's working centre distance
+    (standard gears: ``m (z1 + z2) / 2``, from the cut gears' modules and teeth, not from the
+    radii they were cut for) against the axis distance on the carrier."""
+    by_name = {s.name: s for s in train.stages}
+    meshes = []
+    for name, axis_distance in zip(record["stages"], record["axis_distances"]):
+        stage = by_name[name]
+        drive, driven = stage.generated.profiles
+        working = 0.5 * (drive.module * drive.teeth + driven.module * driven.teeth)
+        meshes.append({"driver": drive.name, "driven": driven.name,
+                       "driver_teeth": int(drive.teeth), "driven_teeth": int(driven.teeth),
+                       "module_mm": float(drive.module),
+                       "centre_distance_mm": float(working),
+                       "axis_distance_mm": float(axis_distance),
+                       "centre_distance_error_mm": float(working - axis_distance)})
+    achieved = -meshes[0]["driver_teeth"] / meshes[-1]["driven_teeth"]
+    return {"name": record["name"], "key": record["key"],
+            "converted_ratio": float(record["converted_ratio"]),
+            "converted_ratio_teeth": float(achieved),
+            "ratio_exact": abs(achieved - record["converted_ratio"]) <= 1e-12,
+            "axes": list(record["axes"]), "meshes": meshes}
 
 
 #: The undercut policy in words, for the report (the threshold is ``MIN_ROOT_THICKNESS``).

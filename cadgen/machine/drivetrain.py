@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 from kinematics.errors import Problem
 
-from cadgen.gears.circular import planting_modules
+from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, planting_modules
 from cadgen.machine.bearings import select_bearing
 from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
 from cadgen.machine.fits import process_fits
@@ -59,20 +59,29 @@ RULES = {
 
 @dataclass(frozen=True)
 class _Axis:
-    """An axis to size: where it is, what it carries, where it leaves its housing."""
+    """An axis to size: where it is, what it carries, where it leaves its housing.
+
+    ``mounts``: ``(gear, z_bottom, face_width)`` in the axis's housing, or ``(gear, z_bottom,
+    face_width, housing, free)`` for a gear turning in another housing's cavity (``z_bottom``
+    from that one's floor) or running ``free`` on the shaft on its own bearings.
+    """
 
     name: str
     housing: str
     side: int
     xy: tuple
     loads: object                 # loads.AxisLoads
-    mounts: tuple                 # (gear, z_bottom, face_width), ...
+    mounts: tuple
     floor_through: bool
     roof_through: bool
     below: object                 # d -> mm beyond the floor's outer face
     above: float
-    external_above: object        # walls -> height of the external load above the roof face
+    external_above: object        # (walls, bases) -> z of the external load (the stack's frame)
     note: str = ""
+    roof_housing: str | None = None   # the upper bearing's housing (None: the axis's own)
+    roof_pair: bool = False       # hollow: both bearings side by side in the housing's roof
+    inside: str | None = None     # hollow: the axis that turns inside it
+    carries: str | None = None    # hollow: the housing its flange is bolted to
 
 
 @dataclass(frozen=True)
@@ -91,6 +100,15 @@ class _Sized:
     reactions: tuple
     bearings: tuple               # (floor, roof): (Bearing, life, passed)
     overhang: float               # height of the external load from the cavity floor (or None)
+    bore: float = 0.0             # a hollow shaft's bore
+
+
+def _mount_fields(mount) -> tuple:
+    """``(gear, z_bottom, face, housing or None, free)`` of an axis's mount tuple."""
+    gear, z, face = mount[:3]
+    housing = mount[3] if len(mount) > 3 else None
+    free = bool(mount[4]) if len(mount) > 4 else False
+    return gear, z, face, housing, free
 
 
 # ------------------------------------------------------------------ layouts
@@ -112,51 +130,130 @@ def _cam_bore_problems(params, shafts) -> list:
                     "out, or give at least that")]
 
 
+#: The flange a hollow shaft carries a housing with (ISO 4762 screws into tapped holes of the
+#: housing's floor): its bolt, the number of bolts, its thickness in bolt diameters, and the
+#: flange's radius beyond the bolt circle, in bolt diameters.
+CARRY_BOLT, CARRY_BOLTS, CARRY_FLANGE_THICKNESS, CARRY_FLANGE_MARGIN = "M6", 6, 1.5, 1.25
+#: Least wall (mm) of a hollow shaft round its bore, under the keyseat.
+HOLLOW_WALL_MIN = 2.0
+
+
+def carry_flange(outside: float) -> dict:
+    """The bolted flange on a hollow shaft of ``outside`` diameter that carries a housing:
+    ``CARRY_BOLTS`` screws of ``CARRY_BOLT`` on a circle 1.5 bolt diameters outside the shaft."""
+    bolt = float(CARRY_BOLT.removeprefix("M"))
+    circle = outside / 2 + 1.5 * bolt
+    return {"bolt": CARRY_BOLT, "bolts": CARRY_BOLTS, "bolt_circle_radius": circle,
+            "radius": circle + CARRY_FLANGE_MARGIN * bolt + bolt / 2,
+            "thickness": CARRY_FLANGE_THICKNESS * bolt}
+
+
+def planting_bases(cavities, gap: float):
+    """``walls -> {housing: z of its cavity floor}`` in gearbox 1's frame: the frame (the
+    transmission box) below gearbox 1, the flange of the sleeve that carries gearbox 1 between
+    them; gearbox 2 above, the flange of the hollow shaft C that carries it between them."""
+    flange = carry_flange(0.0)["thickness"]
+
+    def bases(walls):
+        out = {"gearbox1": 0.0}
+        h1 = cavities["gearbox1"].height
+        out["gearbox2"] = h1 + walls["gearbox1"][1] + gap + flange + gap + walls["gearbox2"][0]
+        if "frame" in cavities:
+            out["frame"] = -(walls["gearbox1"][0] + gap + flange + gap + walls["frame"][1]
+                             + cavities["frame"].height)
+        return out
+    return bases
+
+
 def _planting_axes(params, mechanism) -> tuple:
+    from cadgen.gears.circular import holding_set_module, planting_drive
+    from kinematics.errors import DesignError
+
     housing, gears = params.housing, params.gears
     gap = housing.axial_gap
     module_nc, module_c = planting_modules(mechanism, params.pitch_curve.teeth,
                                            gears.circular_module)
+    try:
+        module_i = holding_set_module(mechanism, gears.circular_module)
+    except DesignError:   # the teeth stage refuses the set and says why; size as set II's
+        module_i = module_c
     face_nc, face_c = gears.face_width_for(module_nc), gears.face_width_for(module_c)
-    box1 = face_c + 2 * gap
+    face_i = gears.face_width_for(module_i)
+    drive = planting_drive(mechanism, module_c, gears.circular_module,
+                           params.field.carrier_speed_rpm)
+    face_d = gears.face_width_for(drive.module_1)
+    # gearbox 1: set I (it holds the central gear) below, set II (it carries gearbox 2) above:
+    # the planet of set II is on the hollow shaft C, set I's on the shaft C2 inside it
+    box1 = face_i + face_c + 3 * gap
+    layer1_2 = 2 * gap + face_i
     box2 = face_nc + face_c + 3 * gap
     layer2 = 2 * gap + face_nc
+    frame_height = 2 * face_d + 3 * gap
     cavities = {
-        "gearbox1": _Cavity(housing.wall_for(module_c), box1, box1, ((gap, face_c),)),
+        "gearbox1": _Cavity(housing.wall_for(max(module_c, module_i)), box1, box1,
+                            ((gap, face_i), (layer1_2, face_c))),
         "gearbox2": _Cavity(housing.wall_for(max(module_nc, module_c)), box2,
                             gap + face_nc + gap / 2, ((gap, face_nc), (layer2, face_c))),
+        "frame": _Cavity(housing.wall_for(drive.module_1), frame_height, frame_height,
+                         ((gap, face_d), (2 * gap + face_d, face_d))),
     }
+    bases = planting_bases(cavities, gap)
     loads = planting_loads(mechanism, params.machine, gears.pressure_angle_rad,
-                           params.field.carrier_speed_rpm)
+                           params.field.carrier_speed_rpm, drive=drive)
     cam, arm = params.cam.thickness, params.planter.arm_thickness
     a, r = float(mechanism.centre_distance), float(mechanism.r)
     line = (math.cos(mechanism.phi0), math.sin(mechanism.phi0))
     radii = mechanism.carrier_radii
 
-    def planter_plane(walls):   # the planter plate's mid-plane above gearbox 2's roof
-        return gap + cam + gap + arm / 2
-
-    def gearbox2_planter(walls):   # the same plane, seen from gearbox 1's roof (C carries box 2)
-        floor2, roof2 = walls["gearbox2"]
-        return gap + floor2 + box2 + roof2 + planter_plane(walls)
+    def planter_plane(walls, base):   # the planter plate's mid-plane above gearbox 2's roof
+        return (base["gearbox2"] + box2 + walls["gearbox2"][1]) + gap + cam + gap + arm / 2
 
     stub = lambda d: STUB_DIAMETERS * d + STUB_EXTRA   # noqa: E731
     none = lambda d: 0.0   # noqa: E731
-    axes = [_Axis("O", "gearbox1", 1, (0.0, 0.0), loads["O"], (("sun", gap, face_c),),
-                  True, False, stub, 0.0, None,
-                  "drive input: the central shaft to the machine's drive")]
+    frame_layers = (gap, 2 * gap + face_d)
+    input_xy = (-drive.centre_distance, 0.0)
+    axes = [
+        # the central shaft: in the frame's floor and gearbox 1's roof; its gear in the frame,
+        # both suns in gearbox 1; it turns inside the sleeve that carries gearbox 1
+        _Axis("O", "frame", 1, (0.0, 0.0), loads["O"],
+              (("central shaft gear", frame_layers[0], face_d),
+               ("sun I", gap, face_i, "gearbox1", False),
+               ("sun", layer1_2, face_c, "gearbox1", False)),
+              False, False, none, 0.0, None, "the central shaft: both suns, driven in the frame",
+              roof_housing="gearbox1"),
+        # the sleeve: bolted to gearbox 1's floor, the transmission driven gear keyed on it,
+        # in a pair of bearings in the frame's roof
+        _Axis("S", "frame", 1, (0.0, 0.0), loads["S"],
+              (("transmission driven gear", frame_layers[1], face_d),),
+              False, True, none, 0.0, planter_plane,
+              "the sleeve: carries gearbox 1 (carrier 1), turned by the transmission driven gear",
+              roof_pair=True, inside="O", carries="gearbox1"),
+        _Axis("input", "frame", 1, input_xy, loads["input"],
+              (("input gear 1", frame_layers[0], face_d),
+               ("input gear 2", frame_layers[1], face_d)),
+              True, False, stub, 0.0, None,
+              "the input: a keyed end below the frame for a sprocket or coupling"),
+    ]
     for side, sign in ((1, 1.0), (2, -1.0)):
-        for axis, gear in (("A", "idler 1"), ("B", "idler 2"), ("C", "train-1 planet")):
-            xy = (sign * radii[axis] * line[0], sign * radii[axis] * line[1])
-            carries = axis == "C"
-            axes.append(_Axis(axis, "gearbox1", side, xy, loads[axis], ((gear, gap, face_c),),
-                              False, carries, none, gap if carries else 0.0,
-                              gearbox2_planter if carries else None,
-                              "carries gearbox 2" if carries else ""))
+        xy = {axis: (sign * radii[axis] * line[0], sign * radii[axis] * line[1])
+              for axis in ("A", "B", "C")}
+        for axis, keyed, free in (("A", "idler 1", "idler 1-I"), ("B", "idler 2", "idler 2-I")):
+            axes.append(_Axis(axis, "gearbox1", side, xy[axis], loads[axis],
+                              ((free, gap, face_i, None, True), (keyed, layer1_2, face_c)),
+                              False, False, none, 0.0, None,
+                              f"{keyed} keyed; {free} (set I) runs free on two bearings"))
+        axes.append(_Axis("C2", "gearbox1", side, xy["C"], loads["C2"],
+                          (("planet I", gap, face_i),
+                           ("central", gap, face_nc, "gearbox2", False)),
+                          False, False, none, 0.0, None,
+                          "inner shaft: planet I (set I, it does not turn) holds the central gear "
+                          "in gearbox 2 through the hollow shaft C", roof_housing="gearbox2"))
+        axes.append(_Axis("C", "gearbox1", side, xy["C"], loads["C"],
+                          (("train-1 planet", layer1_2, face_c),),
+                          False, True, none, 0.0, planter_plane,
+                          "hollow shaft: planet of set II; its flange carries gearbox 2",
+                          roof_pair=True, inside="C2", carries="gearbox2"))
     axes += [
-        _Axis("C2", "gearbox2", 1, (0.0, 0.0), loads["C2"], (("central", gap, face_nc),),
-              True, False, none, 0.0, None,
-              "driven through the hollow shaft C by train 1's second set (not modelled)"),
         _Axis("D", "gearbox2", 1, (a, 0.0), loads["D"],
               (("intermediate", gap, face_nc), ("gear D", layer2, face_c)),
               False, False, none, 0.0, None),
@@ -165,7 +262,7 @@ def _planting_axes(params, mechanism) -> tuple:
               gap + cam + gap + arm, planter_plane,
               "carries the planter; the cam, fixed to gearbox 2, is bored clear of it"),
     ]
-    return axes, cavities, loads
+    return axes, cavities, loads, bases, drive
 
 
 def _pricking_axes(params, design) -> tuple:
@@ -196,9 +293,10 @@ def _pricking_axes(params, design) -> tuple:
               False, False, lambda d: 0.0, 0.0, None),
         _Axis("planet", "gear-case", 1, at(2 * link.a), loads["planet"],
               (("planet", layer2, faces[1]),), False, True, lambda d: 0.0, gap + rocker,
-              lambda walls: gap + rocker / 2, "carries the rocker and the needle"),
+              lambda walls, base: cavity + walls["gear-case"][1] + gap + rocker / 2,
+              "carries the rocker and the needle"),
     ]
-    return axes, cavities, loads
+    return axes, cavities, loads, (lambda walls: {"gear-case": 0.0}), None
 
 
 # ------------------------------------------------------------------ sizing
@@ -212,51 +310,121 @@ def _journal_bore(d: float) -> float:
     return below[-1] if below else bores[0]
 
 
-def _size(axis, cavity, walls, widths, given, machine) -> _Sized:
-    floor_wall, roof_wall = walls[axis.housing]
-    z1, z2 = -widths[0] / 2, cavity.height + widths[1] / 2
-    loads = [(z + face / 2, axis.loads.gears[gear].radial_n) for gear, z, face in axis.mounts]
+def _span(axis, cavities, base, widths) -> tuple:
+    """Heights (mm, from the axis housing's cavity floor) of its two bearings' centres."""
+    h = axis.housing
+    height = cavities[h].height
+    if axis.roof_pair:   # side by side in the roof, from its inner face (first round: 10 mm)
+        w0, w1 = (width or 10.0 for width in widths)
+        return height + w0 / 2, height + w0 + w1 / 2
+    top = axis.roof_housing or h
+    return -widths[0] / 2, base[top] - base[h] + cavities[top].height + widths[1] / 2
+
+
+def _hollow_required(bending: float, torque: float, bore: float, machine) -> float:
+    """The least outside diameter (mm) of a tube of ``bore`` whose largest shear stress under
+    bending and torsion, ``16 d sqrt(M^2 + T^2) / (pi (d^4 - bore^4))``, stays within ``tau / S``
+    (``tau = yield / 2``), by bisection (the stress falls as ``d`` grows)."""
+    tau = machine.shaft_yield_mpa / 2 / machine.shaft_safety_factor
+    moment = math.hypot(bending, torque)
+
+    def stress(d):
+        return 16 * d * moment / (math.pi * (d ** 4 - bore ** 4))
+    low, high = bore + 1e-6, bore + 200.0
+    if moment == 0.0:
+        return bore
+    for _ in range(100):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if stress(middle) > tau else (low, middle)
+    return high
+
+
+def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
+          clearance=0.0) -> _Sized:
+    h = axis.housing
+    z1, z2 = _span(axis, cavities, base, widths)
+    loads = []
+    for mount in axis.mounts:
+        gear, z, face, housing, _ = _mount_fields(mount)
+        offset = base[housing] - base[h] if housing else 0.0
+        loads.append((offset + z + face / 2, axis.loads.gears[gear].radial_n))
     overhang = None
     if axis.loads.external is not None:
-        overhang = cavity.height + roof_wall + axis.external_above(walls)
+        overhang = axis.external_above(walls, base) - base[h]
         loads.append((overhang, axis.loads.external[1]))
     bending = max_bending(z1, z2, loads)
-    required = required_diameter(bending, axis.loads.torque_nmm, machine.shaft_yield_mpa,
-                                 machine.shaft_safety_factor)
-    if given is not None:
-        d = float(given)
+    bore = 0.0
+    if axis.inside is not None and inner is not None:
+        bore = inner.diameter + clearance
+        required = _hollow_required(bending, axis.loads.torque_nmm, bore, machine)
+        fits_tube = [b for b in preferred_diameters()
+                     if _core(b) >= required - 1e-9 and _core(b) - bore >= 2 * HOLLOW_WALL_MIN]
+        d = float(given) if given is not None else (fits_tube[0] if fits_tube
+                                                     else preferred_diameters()[-1])
     else:
-        d = choose_diameter(required) or preferred_diameters()[-1]
+        required = required_diameter(bending, axis.loads.torque_nmm, machine.shaft_yield_mpa,
+                                     machine.shaft_safety_factor)
+        if given is not None:
+            d = float(given)
+        else:
+            d = choose_diameter(required) or preferred_diameters()[-1]
     reactions = tuple(abs(v) for v in beam_reactions(z1, z2, loads))
-    bore = _journal_bore(d)
-    # never a narrower bearing than the last round's: a bearing near its life target could
-    # flip between two widths (a wider wall moves the reactions); growing only, on a finite
-    # catalogue, the rounds settle (and the span is always the chosen bearings')
-    chosen = tuple(select_bearing(bore, load, axis.loads.speed_rpm, machine.bearing_life_min_h,
-                                  min_width=width)
-                   for load, width in zip(reactions, widths))
-    return _Sized(d, required, bending, reactions, chosen, overhang)
+    bore_j = _journal_bore(d)
+    if axis.roof_pair:   # a pair is two of one bearing: chosen for the larger reaction
+        pick = select_bearing(bore_j, max(reactions), axis.loads.speed_rpm,
+                              machine.bearing_life_min_h, min_width=max(widths))
+        from cadgen.machine.bearings import l10_hours
+
+        chosen = tuple((pick[0], life, life >= machine.bearing_life_min_h) for life in
+                       (l10_hours(pick[0].dynamic_load_kn, load, axis.loads.speed_rpm)
+                        for load in reactions))
+    else:
+        # never a narrower bearing than the last round's: a bearing near its life target could
+        # flip between two widths (a wider wall moves the reactions); growing only, on a finite
+        # catalogue, the rounds settle (and the span is always the chosen bearings')
+        chosen = tuple(select_bearing(bore_j, load, axis.loads.speed_rpm,
+                                      machine.bearing_life_min_h, min_width=width)
+                       for load, width in zip(reactions, widths))
+    return _Sized(d, required, bending, reactions, chosen, overhang, bore)
+
+
+def _seat_walls(axis) -> tuple:
+    """``((housing, wall), (housing, wall))`` of the axis's two bearings."""
+    if axis.roof_pair:
+        return (axis.housing, "roof"), (axis.housing, "roof")
+    return (axis.housing, "floor"), (axis.roof_housing or axis.housing, "roof")
 
 
 def _stack_walls(axes, sized, cavities) -> dict:
+    deepest = {(name, wall): 0.0 for name in cavities for wall in ("floor", "roof")}
+    for axis, size in zip(axes, sized):
+        widths = [b[0].width for b in size.bearings]
+        if axis.roof_pair:
+            key = (axis.housing, "roof")
+            deepest[key] = max(deepest[key], widths[0] + widths[1])
+            continue
+        for key, width in zip(_seat_walls(axis), widths):
+            deepest[key] = max(deepest[key], width)
     walls = {}
     for name, cavity in cavities.items():
         shoulder = max(SHOULDER_MIN, SHOULDER_RATIO * cavity.side_wall)
-        deepest = [0.0, 0.0]
-        for key, axis in enumerate(axes):
-            if axis.housing == name:
-                for k in (0, 1):
-                    deepest[k] = max(deepest[k], sized[key].bearings[k][0].width)
-        walls[name] = tuple(max(cavity.side_wall, depth + shoulder) for depth in deepest)
+        walls[name] = tuple(max(cavity.side_wall, deepest[name, wall] + shoulder)
+                            for wall in ("floor", "roof"))
     return walls
 
 
-def _fixed_point(axes, cavities, given, machine) -> tuple:
+def _fixed_point(axes, cavities, given, machine, bases, clearance=0.0) -> tuple:
     walls = {name: (c.side_wall, c.side_wall) for name, c in cavities.items()}
     widths = [(0.0, 0.0)] * len(axes)
     for iteration in range(1, MAX_ITERATIONS + 1):
-        sized = [_size(axis, cavities[axis.housing], walls, widths[k], given.get(axis.name),
-                       machine) for k, axis in enumerate(axes)]
+        base = bases(walls)
+        sized, by_name = [], {}
+        for k, axis in enumerate(axes):
+            inner = by_name.get((axis.inside, axis.side)) if axis.inside else None
+            size = _size(axis, cavities, walls, base, widths[k], given.get(axis.name), machine,
+                         inner, clearance)
+            sized.append(size)
+            by_name[axis.name, axis.side] = size
         new_widths = [tuple(b[0].width for b in s.bearings) for s in sized]
         new_walls = _stack_walls(axes, sized, cavities)
         if new_widths == widths and new_walls == walls:
@@ -274,12 +442,42 @@ def _core(d: float) -> float:
         return d
 
 
-def _mounts(axis, d, fits, machine, report: bool) -> tuple:
+def _free_bearing(axis, gear, face, d, machine, report):
+    """The bearing a free gear runs on (two side by side in its hub), its life and problems."""
+    load = axis.loads.gears[gear]
+    speed = axis.loads.free_speeds.get(gear, 0.0) if hasattr(axis.loads, "free_speeds") else 0.0
+    bearing, life, passed = select_bearing(_journal_bore(d), load.radial_n / 2, speed,
+                                           machine.bearing_life_min_h)
+    problems = []
+    if report and 2 * bearing.width > face + 1e-9:
+        problems.append(Problem("gears.face_width", "free_gear_too_narrow",
+                                f"the {gear} gear runs free on shaft {axis.name} on two "
+                                f"{bearing.designation} bearings ({2 * bearing.width:g} mm side by "
+                                f"side), wider than its {face:g} mm face: widen gears.face_width"))
+    if report and not passed:
+        problems.append(Problem("machine.bearing_life_min_h", "bearing_life_short",
+                                f"the {gear} gear's bearings {bearing.designation} on shaft "
+                                f"{axis.name}: L10h {life:.0f} h is below "
+                                f"{machine.bearing_life_min_h:g} h"))
+    return bearing, speed, life, problems
+
+
+def _mounts(axis, d, fits, machine, report: bool, base=None) -> tuple:
     mounts, problems = [], []
-    for gear, z, face in axis.mounts:
+    for mount_tuple in axis.mounts:
+        gear, z, face, housing, free = _mount_fields(mount_tuple)
+        if housing and base is not None:   # from the shaft's own housing's cavity floor
+            z = base[housing] - base[axis.housing] + z
         load = axis.loads.gears[gear]
         torque = load.torque_nmm
         key, flat = None, 0.0
+        if free:
+            bearing, speed, life, found = _free_bearing(axis, gear, face, d, machine, report)
+            problems += found
+            mounts.append(GearMount(gear, z, face, 0.0, load.radial_n, bearing.outside, None, 0.0,
+                                    fits.seat_allowance(bearing.outside), housing or "",
+                                    bearing, speed, life))
+            continue
         if d < 10.0:
             flat = shaft_core(d)[2]
         else:
@@ -303,8 +501,32 @@ def _mounts(axis, d, fits, machine, report: bool) -> tuple:
                     "give a larger shaft (machine.shafts), or lower the design load "
                     "(machine.tip_load_n, machine.service_factor)"))
         mounts.append(GearMount(gear, z, face, torque / 1000.0, load.radial_n, d, key, flat,
-                                fits.hub_allowance(d)))
+                                fits.hub_allowance(d), housing or ""))
     return tuple(mounts), problems
+
+
+def _flange_problems(axis, d, torque_nmm, flange) -> list:
+    """A carrying flange's screws in shear: ``tau = T / (n A_s r)`` against 0.3 x 640 MPa (8.8,
+    a third of the yield's shear with the service factor already in T)."""
+    from cadgen.machine.catalogue import socket_screw
+
+    # ISO 898-1's stress area: pi / 4 ((d2 + d3) / 2)^2, d2 = d - 0.6495 P, d3 = d - 1.2269 P
+    bolt, pitch = float(flange["bolt"].removeprefix("M")), socket_screw(flange["bolt"])["pitch"]
+    area = math.pi / 4 * ((2 * bolt - 1.8764 * pitch) / 2) ** 2
+    flange["stress_area_mm2"] = area
+    stress = torque_nmm / (flange["bolts"] * area * flange["bolt_circle_radius"])
+    flange["bolt_shear_mpa"] = stress
+    flange["bolt_shear_allow_mpa"] = FLANGE_SHEAR_ALLOW
+    if stress <= FLANGE_SHEAR_ALLOW:
+        return []
+    return [Problem("machine.shafts", "flange_bolts_overloaded",
+                    f"the flange of shaft {axis.name} ({flange['bolts']} x {flange['bolt']}) "
+                    f"carrying {axis.carries} shears its screws at {stress:.0f} MPa, above "
+                    f"{FLANGE_SHEAR_ALLOW:g} MPa")]
+
+
+#: The carrying flange's screws (8.8): allowed shear stress, MPa.
+FLANGE_SHEAR_ALLOW = 190.0
 
 
 def _shaft_problems(axis, sized, given, machine, both_sides) -> list:
@@ -361,13 +583,15 @@ def drivetrain(params, design) -> Drivetrain:
     machine = params.machine
     fits = process_fits(params.manufacturing.process)
     if params.mechanism == "planting":
-        axes, cavities, loads = _planting_axes(params, design)
+        axes, cavities, loads, bases, drive = _planting_axes(params, design)
     elif params.mechanism == "pricking":
-        axes, cavities, loads = _pricking_axes(params, design)
+        axes, cavities, loads, bases, drive = _pricking_axes(params, design)
     else:
         raise ValueError(f"no drivetrain for mechanism {params.mechanism!r}")
     given = machine.shafts.given()
-    sized, walls, iterations, converged = _fixed_point(axes, cavities, given, machine)
+    sized, walls, iterations, converged = _fixed_point(axes, cavities, given, machine, bases,
+                                                       fits.running_clearance)
+    base = bases(walls)
     stacks = {name: HousingStack(name, walls[name][0], walls[name][1], c.height, c.parting_z,
                                  c.layers) for name, c in cavities.items()}
     names_with_sides = {a.name for a in axes if a.side == 2}
@@ -376,24 +600,59 @@ def drivetrain(params, design) -> Drivetrain:
         report = axis.side == 1
         both = axis.name in names_with_sides
         d = size.diameter
-        mounts, mount_problems = _mounts(axis, d, fits, machine, report)
+        mounts, mount_problems = _mounts(axis, d, fits, machine, report, base)
         if report:
             problems += mount_problems + _shaft_problems(axis, size, given.get(axis.name),
                                                          machine, both)
         seats = []
-        for k, wall in enumerate(("floor", "roof")):
+        places = _seat_walls(axis)
+        for k, (housing, wall) in enumerate(places):
+            if axis.roof_pair and k == 1:
+                break   # the pair is one seat of two bearings
             bearing, life, _ = size.bearings[k]
             through = axis.floor_through if wall == "floor" else axis.roof_through
+            load, life_seat = size.reactions[k], life
+            if axis.roof_pair:   # the pair's worse bearing speaks for the seat
+                k_worst = max((0, 1), key=lambda j: size.reactions[j])
+                load, life_seat = size.reactions[k_worst], size.bearings[k_worst][1]
+            # a seat in another housing sits on this axis there: gearbox 2's is centred on C
+            xy = axis.xy if housing == axis.housing else (0.0, 0.0)
             seats.append(BearingSeat(
-                axis.name, axis.housing, axis.side, axis.xy, wall, bearing,
+                axis.name, housing, axis.side, xy, wall, bearing,
                 bearing.outside + fits.seat_allowance(bearing.outside), through,
-                d + fits.running_clearance if through else 0.0, size.reactions[k],
-                axis.loads.speed_rpm, life, machine.bearing_life_min_h))
+                d + fits.running_clearance if through else 0.0, load,
+                axis.loads.speed_rpm, life_seat, machine.bearing_life_min_h,
+                2 if axis.roof_pair else 1))
+        ends = None
+        stack = stacks[axis.housing]
+        if axis.roof_housing is not None:   # from its floor seat to the other housing's roof
+            top = axis.roof_housing
+            ends = (-size.bearings[0][0].width,
+                    base[top] - base[axis.housing] + cavities[top].height
+                    + size.bearings[1][0].width)
+        elif axis.roof_pair:   # the hollow shaft: from its gear to its flange on the next
+            z_low = min(_mount_fields(m)[1] for m in axis.mounts) - 0.0
+            top = axis.carries
+            ends = (z_low, base[top] - base[axis.housing] - walls[top][0])
+        flange = None
+        if axis.carries is not None:
+            flange = carry_flange(d)
+            flange["carries"] = axis.carries
+            if report:
+                problems += _flange_problems(axis, d, axis.loads.torque_nmm, flange)
         shafts.append(Shaft(axis.name, axis.housing, axis.side, axis.xy, d, size.required,
                             axis.name in given, axis.loads.torque_nmm / 1000.0, size.bending,
                             axis.loads.speed_rpm, mounts, tuple(seats),
                             float(axis.below(d)) if axis.floor_through else 0.0,
-                            axis.above if axis.roof_through else 0.0, axis.note))
+                            axis.above if axis.roof_through else 0.0, axis.note,
+                            size.bore, ends, flange))
+        del stack
+    sleeve = next((s for s in shafts if s.name == "S"), None)
+    if sleeve is not None and sleeve.diameter > DRIVE_SLEEVE_DIAMETER + 1e-9:
+        problems.append(Problem("machine.shafts.S", "sleeve_beyond_drive",
+                                f"the sleeve carrying gearbox 1 is {sleeve.diameter:g} mm, more "
+                                f"than the {DRIVE_SLEEVE_DIAMETER:g} mm the drive's driven gear "
+                                "was designed round"))
     problems += _cam_bore_problems(params, shafts)
     if not converged:
         problems.append(Problem("machine", "drivetrain_not_settled",
@@ -416,13 +675,18 @@ def drivetrain(params, design) -> Drivetrain:
              "fits": fits.as_dict(), "iterations": iterations, "converged": converged,
              "overhangs_mm": {f"{a.name}-side{a.side}": s.overhang for a, s in zip(axes, sized)
                               if s.overhang is not None}}
+    if drive is not None:
+        rules["drive"] = drive.as_report()
+        rules["stack_bases_mm"] = base
     return Drivetrain(params.mechanism, tuple(shafts), stacks, fits.process, rules,
-                      tuple(problems))
+                      tuple(problems), drive, base)
 
 
 # ------------------------------------------------------------------ report
 def _length(shaft, stack) -> float:
     """Overall shaft length (mm): stubs, the walls it passes or the bearings it ends in, cavity."""
+    if shaft.ends is not None:
+        return shaft.ends[1] - shaft.ends[0]
     floor, roof = shaft.seats
     low = stack.floor_wall + shaft.extends_below if floor.through else floor.bearing.width
     high = stack.roof_wall + shaft.extends_above if roof.through else roof.bearing.width
@@ -454,8 +718,14 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
                               "h": mount.key.height, "t1": mount.key.shaft_depth,
                               "t2": mount.key.hub_depth, "l": mount.key.length,
                               "pressure_mpa": _finite(pressure)}
+            elif mount.bearing is not None:
+                hub["runs_free_on"] = {"designation": mount.bearing.designation, "count": 2,
+                                       "speed_rpm": mount.speed_rpm,
+                                       "l10_h": _finite(mount.life_h)}
             else:
                 hub["flat_depth_mm"] = mount.flat_depth
+            if mount.housing:
+                hub["housing"] = mount.housing
             hubs.append(hub)
         shafts.append({
             "name": shaft.name, "housing": shaft.housing, "side": shaft.side,
@@ -465,7 +735,8 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
             "torque_nm": shaft.torque_nm, "bending_nmm": shaft.bending_nmm,
             "speed_rpm": shaft.speed_rpm, "length_mm": _length(shaft, stack),
             "extends_below_mm": shaft.extends_below, "extends_above_mm": shaft.extends_above,
-            "strength_passed": shaft.strength_passed, "note": shaft.note, "hubs": hubs})
+            "strength_passed": shaft.strength_passed, "note": shaft.note, "hubs": hubs,
+            "bore_mm": shaft.bore, "flange": shaft.flange})
         for seat in shaft.seats:
             b = seat.bearing
             seats.append({
@@ -474,6 +745,7 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
                 "D_mm": b.outside, "B_mm": b.width, "C_kn": b.dynamic_load_kn,
                 "C0_kn": b.static_load_kn, "seat_diameter_mm": seat.seat_diameter,
                 "through": seat.through, "hole_diameter_mm": seat.hole_diameter,
+                "count": seat.count,
                 "load_n": seat.load_n, "speed_rpm": seat.speed_rpm,
                 "l10_h": _finite(seat.life_h), "target_h": seat.life_min_h,
                 "passed": seat.life_passed})

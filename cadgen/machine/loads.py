@@ -61,48 +61,84 @@ def mesh_resultant(tangential_n: float, pressure_angle: float) -> float:
 
 
 # ------------------------------------------------------------------ planting
-def planting_speeds(mechanism, carrier_rpm: float) -> dict:
+def planting_speeds(mechanism, carrier_rpm: float, drive=None) -> dict:
     """Mean speed of each shaft relative to its housing (r/min), ``omega`` the carrier-1 speed.
 
     Gearbox 2: ``C2``, ``D``, ``E`` make one relative turn per carrier turn (the
     non-circular pair closes 1:1, the circular pair is 1:1): ``omega``. Gearbox 1
-    (relative to carrier 1, the sun turns at ``(n - 1) omega``): ``O`` and ``C``
-    ``(n - 1) omega`` (the sun and the planet have the same radius R), ``A``
-    ``(n - 1) omega / i12``, ``B`` ``(n - 1) omega / i13``.
+    (relative to carrier 1, the suns turn at ``(n - 1) omega``): ``O`` that, and each axis
+    its set-II gear's speed (``A``, ``B`` the idlers' ``(n - 1) omega r_sun / r``, ``C`` the
+    planet's ``2 omega``); ``C2`` (planet I, still) ``omega`` against carrier 1. The frame
+    (fixed): ``S`` (the sleeve, carrier 1) ``omega``, ``input`` ``omega z4 / z3`` (the drive's
+    pair 2); ``O`` turns in the frame at ``n omega`` but its bearings are the frame floor's
+    and gearbox 1's roof's: the larger relative speed, ``n omega``, sizes them.
     """
+    from cadgen.gears.circular import train1_set_radii
+
     omega = float(carrier_rpm)
     relative = (mechanism.n - 1.0) * omega
-    return {"O": relative, "A": relative / mechanism.i12, "B": relative / mechanism.i13,
-            "C": relative, "C2": omega, "D": omega, "E": omega}
+    sun, idler_a, idler_b, planet = train1_set_radii(mechanism, "II")
+    speeds = {"O": mechanism.n * omega, "A": relative * sun / idler_a,
+              "B": relative * sun / idler_b, "C": relative * sun / planet, "C2": omega,
+              "D": omega, "E": omega, "S": omega}
+    if drive is not None:
+        speeds["input"] = float(drive.input_speed_rpm)
+    return speeds
 
 
-def planting_loads(mechanism, machine, pressure_angle: float, carrier_rpm: float) -> dict:
-    """``{axis: AxisLoads}`` of the planting mechanism (both trains), one arm's chain.
+def free_speeds(mechanism, carrier_rpm: float) -> dict:
+    """Speeds (r/min) of set I's idlers relative to the shafts A and B they run free on
+    (the set-II idlers, keyed): ``(n - 1) omega |r_s1 / r_1 - r_s2 / r_2|``."""
+    from cadgen.gears.circular import train1_set_radii
+
+    relative = (mechanism.n - 1.0) * float(carrier_rpm)
+    two, one = train1_set_radii(mechanism, "II"), train1_set_radii(mechanism, "I")
+    return {"idler 1-I": relative * abs(one[0] / one[1] - two[0] / two[1]),
+            "idler 2-I": relative * abs(one[0] / one[2] - two[0] / two[2])}
+
+
+@dataclass(frozen=True)
+class FreeAxisLoads(AxisLoads):
+    """An axis with gears running free on it: their speeds relative to the shaft."""
+
+    free_speeds: dict = field(default_factory=dict)
+
+
+def planting_loads(mechanism, machine, pressure_angle: float, carrier_rpm: float,
+                   drive=None) -> dict:
+    """``{axis: AxisLoads}`` of the planting mechanism (both trains and the drive), one arm.
 
     With ``F`` the design load, ``a`` the centre distance, ``r1`` the central gear's
-    pitch radius, ``r`` the 1:1 circular gears' and ``R`` train 1's:
+    pitch radius, ``r`` the 1:1 circular gears', ``r_s``, ``r_p`` the suns' and planets' of
+    train 1's sets (II: carries gearbox 2; I: holds the central gear):
 
     - E (planet gear E, the planter on it): ``T_E = F sqrt(L1^2 + L2^2)``; an
       external radial load ``F`` at the planter plate's plane (above the roof);
     - D: ``T_D = T_E``; gear D's mesh ``Ft = T_E / r``; the intermediate gear's
       mesh ``Ft = T_D / (a - max r1)`` (its smallest radius);
-    - C2 (the central gear): ``T_C2 = T_D max(r1 / (a - r1))``, the same mesh force;
-    - C (train 1's planet, carrying gearbox 2): the moments about C on the arm (gearbox
-      2, its gears and the planter) balance, so ``T_C <= F |CN| + T_C2`` with
-      ``|CN| <= a + 2 r + sqrt(L1^2 + L2^2)``; mesh ``Ft1 = T_C / R``; the tool's load
+    - C2 (inner shaft: planet I and the central gear): ``T_C2 = T_D max(r1 / (a - r1))``;
+      set I's mesh ``Ft_I = T_C2 / r_pI``;
+    - C (hollow shaft: set II's planet, carrying gearbox 2): the moments about C on the arm
+      (gearbox 2, its gears and the planter) balance, so ``T_C <= F |CN| + T_C2`` with
+      ``|CN| <= a + 2 r + sqrt(L1^2 + L2^2)``; mesh ``Ft_II = T_C / r_pII``; the tool's load
       ``F`` reaches it through gearbox 2's housing, above its roof;
-    - O (the central shaft, both suns): ``T_O = T_C + T_C2 / 2``: the two arms are half a
-      turn apart and each is in the soil for a short part of the turn, so one arm loads
-      the suns at a time; the converted ratio -1/2 set's sun carries its planet's torque
-      halved (sun-to-planet ratio 1:2; that set's gears are not modelled); radial load of
-      one loaded side ``Ft1``;
-    - A, B (idlers): no torque, radial ``<= 2 Ft1`` (two meshes).
+    - O (the central shaft, both suns): ``T_O = T_C r_sII / r_pII + T_C2 r_sI / r_pI``: the two
+      arms are half a turn apart and each is in the soil for a short part of the turn, so one
+      arm loads the suns at a time; the drive's gear on it ``Ft = T_O / r_2``;
+    - A, B (set II's idlers keyed, set I's free on them): no torque, radial ``2 Ft`` per idler;
+    - S (the sleeve carrying gearbox 1, the transmission driven gear on it): the moments about
+      O on carrier 1: ``T_S = F (Rc + |CN|) + T_O``, mesh ``Ft = T_S / r_4``; ``F`` at the
+      planter's plane;
+    - input: ``T_in = T_O z1 / z2 + T_S z3 / z4`` (the drive's pairs), both meshes.
     """
+    from cadgen.gears.circular import train1_set_radii
+
     F = design_load(machine)
     closure = mechanism.closure
-    a, r, R = float(mechanism.centre_distance), float(mechanism.r), float(mechanism.R)
+    a, r = float(mechanism.centre_distance), float(mechanism.r)
     r1_max = float(closure.radius_max[1])
     ratio_max = float(closure.ratio_max)
+    set2, set1 = train1_set_radii(mechanism, "II"), train1_set_radii(mechanism, "I")
     T_E = F * math.hypot(mechanism.L1, mechanism.L2)
     T_D = T_E
     Ft_circular = T_E / r
@@ -110,39 +146,67 @@ def planting_loads(mechanism, machine, pressure_angle: float, carrier_rpm: float
     T_C2 = T_D * ratio_max
     reach_C = a + 2.0 * r + math.hypot(mechanism.L1, mechanism.L2)
     T_C = F * reach_C + T_C2
-    Ft_1 = T_C / R
-    T_O = T_C + 0.5 * T_C2
-    speeds = planting_speeds(mechanism, carrier_rpm)
+    Ft_2 = T_C / set2[3]
+    Ft_1 = T_C2 / set1[3]
+    T_sun2, T_sun1 = T_C * set2[0] / set2[3], T_C2 * set1[0] / set1[3]
+    T_O = T_sun2 + T_sun1
+    speeds = planting_speeds(mechanism, carrier_rpm, drive)
 
     def load(gear, torque, tangential, meshes=1):
         return GearLoad(gear, torque, tangential, meshes * mesh_resultant(tangential,
                                                                          pressure_angle))
 
+    frees = free_speeds(mechanism, carrier_rpm)
     axes = {
-        "O": AxisLoads("O", T_O, {"sun": load("sun", T_O, Ft_1)}, speeds["O"]),
-        "A": AxisLoads("A", 0.0, {"idler 1": load("idler 1", 0.0, Ft_1, meshes=2)},
-                       speeds["A"]),
-        "B": AxisLoads("B", 0.0, {"idler 2": load("idler 2", 0.0, Ft_1, meshes=2)},
-                       speeds["B"]),
-        "C": AxisLoads("C", T_C, {"train-1 planet": load("train-1 planet", T_C, Ft_1)},
+        "O": AxisLoads("O", T_O, {"sun": load("sun", T_sun2, Ft_2),
+                                  "sun I": load("sun I", T_sun1, Ft_1)}, speeds["O"]),
+        "A": FreeAxisLoads("A", 0.0, {"idler 1": load("idler 1", 0.0, Ft_2, meshes=2),
+                                      "idler 1-I": load("idler 1-I", 0.0, Ft_1, meshes=2)},
+                           speeds["A"], free_speeds={"idler 1-I": frees["idler 1-I"]}),
+        "B": FreeAxisLoads("B", 0.0, {"idler 2": load("idler 2", 0.0, Ft_2, meshes=2),
+                                      "idler 2-I": load("idler 2-I", 0.0, Ft_1, meshes=2)},
+                           speeds["B"], free_speeds={"idler 2-I": frees["idler 2-I"]}),
+        "C": AxisLoads("C", T_C, {"train-1 planet": load("train-1 planet", T_C, Ft_2)},
                        speeds["C"], external=("roof", F)),
-        "C2": AxisLoads("C2", T_C2, {"central": load("central", T_C2, Ft_noncircular)},
+        "C2": AxisLoads("C2", T_C2, {"planet I": load("planet I", T_C2, Ft_1),
+                                     "central": load("central", T_C2, Ft_noncircular)},
                         speeds["C2"]),
         "D": AxisLoads("D", T_D, {"intermediate": load("intermediate", T_D, Ft_noncircular),
                                   "gear D": load("gear D", T_D, Ft_circular)}, speeds["D"]),
         "E": AxisLoads("E", T_E, {"planet gear E": load("planet gear E", T_E, Ft_circular)},
                        speeds["E"], external=("roof", F)),
     }
+    values = {"F_n": F, "T_E_nmm": T_E, "T_C2_nmm": T_C2, "T_C_nmm": T_C, "T_O_nmm": T_O,
+              "a_mm": a, "r1_max_mm": r1_max, "ratio_max": ratio_max}
+    if drive is not None:
+        z1, z2, z3, z4 = drive.teeth
+        r2, r4 = drive.radii[1], drive.radii[3]
+        T_S = F * (mechanism.carrier_radii["C"] + reach_C) + T_O
+        T_in = T_O * z1 / z2 + T_S * z3 / z4
+        Ft_d1, Ft_d2 = T_O / r2, T_S / r4
+        axes["O"].gears["central shaft gear"] = load("central shaft gear", T_O, Ft_d1)
+        axes["S"] = AxisLoads("S", T_S, {"transmission driven gear": load(
+            "transmission driven gear", T_S, Ft_d2)}, speeds["S"], external=("roof", F))
+        axes["input"] = AxisLoads("input", T_in, {
+            "input gear 1": load("input gear 1", T_O * z1 / z2, Ft_d1),
+            "input gear 2": load("input gear 2", T_S * z3 / z4, Ft_d2)}, speeds["input"])
+        values.update({"T_S_nmm": T_S, "T_input_nmm": T_in})
     formulas = {"F": "tip_load_n * service_factor", "T_E": "F sqrt(L1^2 + L2^2)",
                 "T_D": "T_E", "Ft_D-E": "T_E / r", "Ft_nc": "T_D / (a - max r1)",
                 "T_C2": "T_D max(r1 / (a - r1))", "T_C": "F (a + 2 r + sqrt(L1^2 + L2^2)) + T_C2",
-                "Ft_1": "T_C / R", "T_O": "T_C + T_C2 / 2 (one arm in the soil at a time)", "idlers": "radial 2 Ft_1 / cos(alpha), no torque",
+                "Ft_II": "T_C / r_pII", "Ft_I": "T_C2 / r_pI",
+                "T_O": "T_C r_sII / r_pII + T_C2 r_sI / r_pI (one arm in the soil at a time)",
+                "idlers": "radial 2 Ft / cos(alpha) each, no torque",
+                "T_S": "F (Rc + a + 2 r + sqrt(L1^2 + L2^2)) + T_O (moments about O on carrier 1)",
+                "T_input": "T_O z1 / z2 + T_S z3 / z4",
                 "resultant": "Ft / cos(alpha)"}
-    values = {"F_n": F, "T_E_nmm": T_E, "T_C2_nmm": T_C2, "T_C_nmm": T_C, "T_O_nmm": T_O,
-              "a_mm": a, "r1_max_mm": r1_max, "ratio_max": ratio_max}
-    return {axis: AxisLoads(v.axis, v.torque_nmm, v.gears, v.speed_rpm, v.external,
-                            {"formulas": formulas, "values": values})
-            for axis, v in axes.items()}
+    info = {"formulas": formulas, "values": values}
+    out = {}
+    for name, v in axes.items():
+        extra = {"free_speeds": v.free_speeds} if isinstance(v, FreeAxisLoads) else {}
+        kind = FreeAxisLoads if extra else AxisLoads
+        out[name] = kind(v.axis, v.torque_nmm, v.gears, v.speed_rpm, v.external, info, **extra)
+    return out
 
 
 # ------------------------------------------------------------------ pricking

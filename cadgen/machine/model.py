@@ -1,6 +1,6 @@
 """What the machine design of a mechanism comes to: shafts, their bearings and seats, hubs.
 
-These records are the interface between the sizing rules (:mod:`cadgen.machine.drivetrain`,
+These records are the interface between the sizing rules (:mod:`cadgen.gears.drivetrain`,
 numbers only) and the solids that are built from them (:mod:`cadgen.solids`): the
 solids never size anything, the sizing never builds a solid.
 
@@ -15,6 +15,7 @@ gearbox 1 that exists on both sides of carrier 1 is listed once per side (``side
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 __all__ = ["Bearing", "KeySize", "BearingSeat", "GearMount", "Shaft", "HousingStack",
@@ -72,10 +73,16 @@ class BearingSeat:
     speed_rpm: float          # mean speed of the inner ring relative to the housing
     life_h: float             # ISO 281 basic rating life L10h; inf when the load is 0
     life_min_h: float
+    count: int = 1            # bearings side by side in the seat (2: a pair, face to face)
 
     @property
     def life_passed(self) -> bool:
         return self.life_h >= self.life_min_h
+
+    @property
+    def depth(self) -> float:
+        """How deep the seat is bored: its bearings' widths side by side (mm)."""
+        return self.count * self.bearing.width
 
 
 @dataclass(frozen=True)
@@ -91,6 +98,11 @@ class GearMount:
     key: KeySize | None       # None: a D-flat (small shafts) or a fixed gear
     flat_depth: float         # D-flat depth from the shaft surface, mm (0: none)
     bore_allowance: float     # the hub bore's diametral allowance from the process's fit, mm
+    housing: str = ""         # the housing it turns in, when not its shaft's ("": the shaft's)
+    bearing: Bearing | None = None   # runs free on the shaft on two of these (an idler of
+    #                                  another set): hub bore = their OD + the seat's fit
+    speed_rpm: float = 0.0    # a free gear's speed relative to its shaft (its bearings')
+    life_h: float = math.inf  # ... and their L10h under half its radial load each
 
 
 @dataclass(frozen=True)
@@ -112,6 +124,10 @@ class Shaft:
     extends_below: float      # beyond the floor's outer face, mm (0: ends in a blind seat)
     extends_above: float      # beyond the roof's outer face, mm
     note: str = ""            # what it drives or is driven by beyond the housing
+    bore: float = 0.0         # a hollow shaft's bore (mm): another shaft turns inside it
+    ends: tuple | None = None  # (z_bottom, z_top) from its housing's cavity floor (mm), when
+    #                            it reaches into another housing; None: from its seats
+    flange: dict | None = None  # a hollow shaft's bolted flange carrying a housing
 
     @property
     def strength_passed(self) -> bool:
@@ -140,10 +156,21 @@ class Drivetrain:
     process: str
     rules: dict = field(default_factory=dict)   # the formulas and constants, for the report
     problems: tuple = ()      # kinematics.errors.Problem of failing checks (life, strength, rim)
+    drive: object = None      # cadgen.gears.drive.DriveDesign of the frame's two pairs, or None
+    bases: dict = field(default_factory=dict)   # housing -> z of its cavity floor (mm), in
+    #                                              the first housing's frame
 
     def seats(self, housing: str) -> list:
-        """The bearing seats of one housing, every side."""
-        return [seat for shaft in self.shafts for seat in shaft.seats if seat.housing == housing]
+        """The bearing seats of one housing, every side; a seat two shafts' records share (the
+        inner shafts C2 of both arms end in gearbox 2's roof, one housing part per arm) once."""
+        out, seen = [], set()
+        for shaft in self.shafts:
+            for seat in shaft.seats:
+                key = (seat.shaft, seat.wall, tuple(round(float(v), 9) for v in seat.xy))
+                if seat.housing == housing and key not in seen:
+                    seen.add(key)
+                    out.append(seat)
+        return out
 
     def shaft_of_gear(self, gear: str) -> tuple:
         """``(shaft, mount)`` carrying the named gear (side 1 when it exists on both sides)."""

@@ -286,7 +286,8 @@ def _parts(run, gears: bool = True):
     soil_level = run.values["metrics"].events.soil_level if run.soil else None  # bench: none
     assembly, housings, _ = planting_assembly(params, run.values["kinematics"], train, cam,
                                               soil_level, drivetrain=run.values["drivetrain"])
-    return solids_outcome(params, assembly, {"gearbox1": housings[0], "gearbox2": housings[1]})
+    return solids_outcome(params, assembly, dict(zip(("gearbox1", "gearbox2", "frame"),
+                                                     housings)))
 
 
 def _arm_interference(run):

@@ -40,13 +40,14 @@ __all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
 
 #: Parts of one planting arm (instances carry ``-arm1`` / ``-arm2``); those absent from an
 #: assembly are skipped (no cam without a cuttable cam design, ...).
-ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "shaft-C2", "shaft-D", "shaft-E", "cam",
+ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "shaft-D", "shaft-E", "cam",
              "planter-shell", "blade-right", "blade-left")
 #: The parts fixed in gearbox 2's body (the first group of :func:`_arm_part_bounds`).
 _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
 #: Gearbox 2's shafts, turning on their axes with their gears.
-_GEARBOX2_SHAFTS = ("shaft-C2", "shaft-D", "shaft-E")
-#: The housings kept clear of the ground: gearbox 1 (one instance) and gearbox 2 (per arm).
+_GEARBOX2_SHAFTS = ("shaft-D", "shaft-E")
+#: The housings kept clear of the ground: gearbox 1 (one instance) and gearbox 2 (per arm); the
+#: frame (fixed, below gearbox 1) too, when the assembly has it.
 _GROUND_HOUSINGS = {"gearbox1": ("gearbox1-base", "gearbox1-cover"),
                     "gearbox2": ("gearbox2-base", "gearbox2-cover")}
 #: A housing half cut into segments to fit a printer: ``<half>-1``, ``<half>-2``, ...
@@ -262,13 +263,16 @@ def ground_clearance(params, design, solids, field) -> dict:
     rc = design.carrier_radii["C"]
     box1 = _present(_GROUND_HOUSINGS["gearbox1"], parts)
     box2 = _present(_GROUND_HOUSINGS["gearbox2"], parts)
-    housings = list(box1) + [f"{name}-{arm}" for name in box2 for arm in ("arm1", "arm2")]
+    frame = _present(("frame-base", "frame-cover"), parts)
+    housings = (list(box1) + [f"{name}-{arm}" for name in box2 for arm in ("arm1", "arm2")]
+                + list(frame))
     # gearbox 1 turns about O at rate 1; gearbox 2 about C, which circles at rc (a point
     # moves at most its reach, and accelerates at most the same, per radian)
     reach = {name: part_reach(parts[name], axis=_Z) for name in box1}
     reach.update({f"{name}-{arm}": rc + part_reach(parts[name], axis=_Z)
                   for name in box2 for arm in ("arm1", "arm2")})
     speed = max(reach.values())
+    reach.update({name: 0.0 for name in frame})   # the frame is fixed
     scene = FclScene(assembly, housings, ["ground"])
     result = certified_distance(scene, lipschitz=speed, acceleration=speed,
                                 atol=params.resolution.sweep_atol, steps=SWEEP_STEPS,

@@ -99,12 +99,32 @@ def _bought_rows(drivetrain, housings: dict, copies: dict, gears: set) -> list:
             bearing = seat.bearing
             name = (f"deep-groove ball bearing {bearing.designation}-2Z "
                     f"({bearing.bore:g} x {bearing.outside:g} x {bearing.width:g} mm)")
-            bearings[name] += copies.get(seat.housing, 1)
+            # a seat in the shaft's own housing is placed as often as it; one in another
+            # housing (C2's in gearbox 2's roof) belongs to this shaft's record once
+            placed = copies.get(seat.housing, 1) if seat.housing == shaft.housing else 1
+            bearings[name] += placed * getattr(seat, "count", 1)
             describe[name] = ("bearing", bearing.designation)
         for mount in shaft.mounts:
             if mount.key is not None and mount.gear.replace(" ", "-") in gears:
                 keys[mount.key.designation] += n
                 describe[mount.key.designation] = ("key", mount.key.designation)
+            bearing = getattr(mount, "bearing", None)
+            if bearing is not None:   # a gear running free on the shaft: two in its hub
+                name = (f"deep-groove ball bearing {bearing.designation}-2Z "
+                        f"({bearing.bore:g} x {bearing.outside:g} x {bearing.width:g} mm)")
+                bearings[name] += 2 * n
+                describe[name] = ("bearing", bearing.designation)
+        flange = getattr(shaft, "flange", None)
+        if flange and shaft.side == 1:   # the carrying flange's screws, per copy of the shaft
+            sides = sum(1 for s in drivetrain.shafts if s.name == shaft.name)
+            from cadgen.machine.catalogue import screw_length
+
+            thread = flange["bolt"]
+            length = screw_length(thread, float(flange["thickness"])
+                                  + 1.5 * float(thread.removeprefix("M")))
+            item = f"ISO 4762 {thread} x {length:g} - 8.8"
+            fasteners[item] += sides * int(flange["bolts"])
+            describe[item] = ("socket head cap screw", item)
     for name, housing in housings.items():
         count = len(getattr(housing, "bolt_positions", ()))
         if not count:

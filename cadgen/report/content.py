@@ -203,7 +203,17 @@ def machine_section(params, drivetrain, train=None) -> dict:
                      "where_mm": [list(map(float, point)) for point in rim.where],
                      "problems": [p.as_dict() for p in rim.problems]})
     section["hubs"] = rims
+    section["assembly"] = assembly_section(params, drivetrain, train)
     return section
+
+
+def assembly_section(params, drivetrain, train=None) -> dict:
+    """The joint graph (:mod:`cadgen.assembly.machine`): parts, joints, mobility, loose parts."""
+    from cadgen.assembly.machine import model_report, planting_model, pricking_model
+
+    meshes = [tuple(stage.generated.pair.names) for stage in (train.stages if train else ())]
+    build = planting_model if params.mechanism == "planting" else pricking_model
+    return model_report(build(drivetrain, meshes))
 
 
 def _replace_kinematic_estimates(report: dict, sweeps: dict) -> None:

@@ -316,6 +316,8 @@ def _gear_pair_words(slug: str) -> str:
     E"``, ``"train-1-sun-to-idler-1"`` -> ``"train 1: sun to idler 1"``, ``"non-circular-pair"``
     stays hyphenated."""
     text = re.sub(r"^(\d+)-(\d+)-pair\b", r"\1:\2 pair", slug)
+    text = re.sub(r"\btrain-(\d+)-set-(i+)-", lambda m: f"train {m[1]} set {m[2].upper()}: ",
+                  text)
     text = re.sub(r"\btrain-(\d+)-(?=[a-z])", r"train \1: ", text)
     text = text.replace("non-circular", "non\0circular")   # a hyphen the next line keeps
     text = text.replace("-", " ").replace("\0", "-")

@@ -74,15 +74,28 @@ def housing_circles(params, mechanism) -> list:
     circles = envelope_circles(
         mechanism, mechanism.module(params.pitch_curve.teeth), shells["gearbox2"].envelope,
         circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].envelope,
-        shifts=params.gears.profile_shift.resolved())
+        shifts=params.gears.profile_shift.resolved(),
+        holding_module=_holding_module(params, mechanism))
     explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
     return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
             for c in circles]
 
 
+def _holding_module(params, mechanism):
+    """Set I's module as the teeth stage cuts it, or None when it cannot be cut."""
+    from cadgen.gears.circular import holding_set_module
+    from kinematics.errors import DesignError
+
+    try:
+        return holding_set_module(mechanism, params.gears.circular_module)
+    except DesignError:
+        return None
+
+
 def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: float, *,
                             circular_module: float | None = None,
-                            gearbox1_allowance: float | None = None, shifts=None):
+                            gearbox1_allowance: float | None = None, shifts=None,
+                            holding_module: float | None = None):
     """Envelope circles of both gearboxes: the largest gear tip about each axis plus ``allowance``.
 
     Gearbox 2 holds the non-circular pair and the 1:1 pair: at C the central
@@ -111,8 +124,19 @@ def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: flo
     box2 = {"C": r_max + tip("central", module) + allowance,
             "D": max(a - r_min + tip("intermediate", module), r + tip("gear_D", m_c)) + allowance,
             "E": r + tip("planet_gear_E", m_c) + allowance}
-    box1 = {"O": R + tip("sun", m_c) + outer1, "A": R * mechanism.i12 + tip("idler_1", m_c) + outer1,
-            "B": R * mechanism.i13 + tip("idler_2", m_c) + outer1,
-            "C": R + tip("train_1_planet", m_c) + outer1}
+    from cadgen.gears.circular import holding_set_module, train1_set_radii
+    from kinematics.errors import DesignError
+
+    two = train1_set_radii(mechanism, "II")
+    box1 = {"O": two[0] + tip("sun", m_c) + outer1, "A": two[1] + tip("idler_1", m_c) + outer1,
+            "B": two[2] + tip("idler_2", m_c) + outer1,
+            "C": two[3] + tip("train_1_planet", m_c) + outer1}
+    try:   # set I (it holds the central gear) shares the axes: the larger gear on each
+        m_i = holding_module or holding_set_module(mechanism, None)
+        one = train1_set_radii(mechanism, "I")
+        for axis, radius in zip("OABC", one):
+            box1[axis] = max(box1[axis], radius + m_i + outer1)
+    except DesignError:   # the set cannot be cut: the teeth stage says why
+        pass
     return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
             + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])

@@ -160,6 +160,8 @@ def shaft_ends(shaft, housing) -> tuple:
     wall, that wall's outer face.
     """
     z0 = housing.z_cavity_bottom
+    if getattr(shaft, "ends", None) is not None:   # it reaches into another housing
+        return z0 + shaft.ends[0], z0 + shaft.ends[1]
     z_cavity_top = z0 + housing.cavity_height
     bottom, top = z0 - housing.floor_wall, z_cavity_top + housing.roof_wall
     for seat in shaft.seats:
@@ -220,6 +222,8 @@ def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=
             flat, flat_angle = float(mount.flat_depth), direction(mount)
     solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
                         flat_angle=flat_angle, segments=segments)
+    if getattr(shaft, "bore", 0.0) > 0.0:
+        solid = _hollow(solid, shaft, z_bottom, z_top, segments)
     offset = tuple(float(v) for v in shaft.xy)
     if first is None:
         local = (lambda phi, at=planar_transform(0.0, offset): at)
@@ -227,3 +231,43 @@ def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=
         def local(phi, first=first, offset=offset):
             return planar_transform(_turn_of(first(phi)), offset)
     return Part(f"shaft-{shaft.name}", "shaft", body, solid, local, tuple(instances))
+
+
+def _hollow(solid, shaft, z_bottom: float, z_top: float, segments: int):
+    """A hollow shaft: its bore through, and its flange (with the screws' clearance holes) at
+    the top, where it is bolted to the housing it carries."""
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
+    length = z_top - z_bottom
+    bore = m3d.Manifold.cylinder(length + 2.0, shaft.bore / 2, shaft.bore / 2, segments)
+    solid = solid - bore.translate((0.0, 0.0, z_bottom - 1.0))
+    flange = shaft.flange
+    if not flange:
+        return solid
+    thick = float(flange["thickness"])
+    disc = (m3d.Manifold.cylinder(thick, flange["radius"], flange["radius"], segments)
+            - m3d.Manifold.cylinder(thick + 2.0, shaft.bore / 2, shaft.bore / 2,
+                                    segments).translate((0.0, 0.0, -1.0)))
+    disc = disc - flange_bolt_holes(flange, thick, segments)
+    return solid + disc.translate((0.0, 0.0, z_top - thick))
+
+
+def flange_bolt_holes(flange: dict, height: float, segments: int, diameter=None):
+    """The carrying flange's bolt holes as cylinders from z = -1 to ``height + 1`` (ISO 273
+    medium clearance holes, or ``diameter``: a tapped hole's drill)."""
+    import math as _math
+
+    from cadgen.machine.catalogue import clearance_hole
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
+    hole = diameter if diameter is not None else clearance_hole(flange["bolt"], "medium")
+    out = None
+    for k in range(int(flange["bolts"])):
+        angle = 2 * _math.pi * k / int(flange["bolts"])
+        x, y = (flange["bolt_circle_radius"] * _math.cos(angle),
+                flange["bolt_circle_radius"] * _math.sin(angle))
+        cyl = m3d.Manifold.cylinder(height + 2.0, hole / 2, hole / 2, 24).translate((x, y, -1.0))
+        out = cyl if out is None else out + cyl
+    return out

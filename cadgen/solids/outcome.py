@@ -244,10 +244,19 @@ def enclosure_checks(assembly, housings: dict) -> list:
                     if p.name in (housing_name, f"{housing_name}-base", f"{housing_name}-base-1"))
         worst, worst_gear, axial_ok = np.inf, None, True
         for part in assembly.parts:
-            if part.kind != "gear" or part.body != body:
+            if part.kind != "gear":
                 continue
             bottom, top = part.mesh.bounds[:, 2]
             local = part.local(0.0)
+            middle = 0.5 * (bottom + top) + local[2, 3]
+            # a gear in this cavity: on the housing's body, or (the central shaft's and the
+            # sleeve's gears in the frame, on carrier 1's body about its fixed axis O) coaxial
+            # with the housing's origin and between its end walls
+            if part.body != body and not (z_low <= middle <= z_high
+                                          and np.allclose(local[:2, 3], 0.0, atol=1e-6)):
+                continue
+            if part.body == body and not (z_low - 1.0 <= middle <= z_high + 1.0):
+                continue   # coaxial with this body, but turning in another housing's cavity
             reach = float(np.max(np.linalg.norm(part.outline, axis=1)))
             axial_ok &= bool(z_low <= bottom + local[2, 3] + 1e-9
                              and top + local[2, 3] <= z_high + 1e-9)

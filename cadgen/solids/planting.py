@@ -76,6 +76,8 @@ class PlantingLayout:
     box2_roof_wall: float
     box1_layers: tuple              # absolute z of each gear layer's bottom
     box2_layers: tuple
+    frame_floor: float = 0.0        # the frame's (transmission box's) cavity floor
+    frame_layers: tuple = ()        # its two gear layers' bottoms (the drive's pairs)
 
     @property
     def layer0(self) -> float:
@@ -94,7 +96,10 @@ class PlantingLayout:
 
     @property
     def z_range(self) -> tuple:
-        return (self.box1_floor - self.box1_floor_wall, self.tube_axis + self.tube_radius)
+        low = self.box1_floor - self.box1_floor_wall
+        if self.frame_layers:   # the frame below gearbox 1 (its floor wall: 2 x its seats, say)
+            low = min(low, self.frame_floor - 40.0)
+        return (low, self.tube_axis + self.tube_radius)
 
 
 def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayout:
@@ -110,7 +115,7 @@ def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayo
     stack1, stack2 = drivetrain.stacks["gearbox1"], drivetrain.stacks["gearbox2"]
     walls = (stack1.floor_wall, stack1.roof_wall, stack2.floor_wall, stack2.roof_wall)
     box1_height, box2_height = stack1.cavity_height, stack2.cavity_height
-    box2_floor = box1_height + walls[1] + gap + walls[2]
+    box2_floor = drivetrain.bases.get("gearbox2", box1_height + walls[1] + gap + walls[2])
     cam_bottom = box2_floor + box2_height + walls[3] + gap
     cam_thickness = params.cam.thickness if cam_design is not None else 0.0
     arm_bottom = cam_bottom + cam_thickness + gap
@@ -120,9 +125,12 @@ def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayo
     tube_axis = arm_bottom + arm_thickness + tube_radius - params.planter.shell_wall
     layers1 = tuple(z for z, _ in stack1.layers)
     layers2 = tuple(box2_floor + z for z, _ in stack2.layers)
+    frame = drivetrain.stacks.get("frame")
+    frame_floor = drivetrain.bases.get("frame", 0.0)
+    frame_layers = tuple(frame_floor + z for z, _ in frame.layers) if frame is not None else ()
     return PlantingLayout(face_nc, face_c, gap, 0.0, box1_height, w1, box2_floor, box2_height, w2,
                           cam_bottom, cam_thickness, arm_bottom, arm_thickness, tube_axis,
-                          tube_radius, *walls, layers1, layers2)
+                          tube_radius, *walls, layers1, layers2, frame_floor, frame_layers)
 
 
 def _tube_radius(params, cam_design) -> float:
@@ -139,7 +147,7 @@ def body_poses(mechanism, layout):
     """``(body, phi) -> 4x4`` world transform of each body at carrier angle ``phi``."""
 
     def pose(body, phi):
-        if body in ("carrier1", "ground"):
+        if body in ("carrier1", "ground", "frame"):
             return planar_transform(-phi if body == "carrier1" else 0.0)
         phi_array = np.array([phi])
         if body == "gearbox2":
@@ -159,29 +167,49 @@ def _gear_parts(params, mechanism, train, layout, segments):
     frames)``, ``frames`` each gear's ``(placement, keyway angle)`` for its shaft's keyseat."""
     from cadgen.gears.trains import _placements
 
+    from cadgen.gears.circular import TRAIN1_SETS, train1_set_radii
+
     n = mechanism.n
     F = mechanism.intermediate_rotation
-    R = mechanism.R
-    # each gear's rotation relative to its body, from the catching pose (rad)
+    # each gear's rotation relative to its body, from the catching pose (rad): gearbox 2 turns
+    # by +phi, carrier 1 by -phi, the suns and the central shaft's gear by -n phi (absolute)
     relative = {
         "central": lambda phi: -phi,
         "intermediate": lambda phi: float(F(phi)),
         "gear D": lambda phi: float(F(phi)),
         "planet gear E": lambda phi: -float(F(phi)),
-        "sun": lambda phi: -(n - 1) * phi,
-        "idler 1": lambda phi: (n - 1) * phi * R / (R * mechanism.i12),
-        "idler 2": lambda phi: -(n - 1) * phi * R / (R * mechanism.i13),
-        "train-1 planet": lambda phi: (n - 1) * phi,
+        "central shaft gear": lambda phi: -(n - 1) * phi,
+        "transmission driven gear": lambda phi: 0.0,
     }
-    in_box2 = {"central": layout.layer1, "intermediate": layout.layer1,
-               "gear D": layout.layer2, "planet gear E": layout.layer2}
+    z_of = {"central": layout.layer1, "intermediate": layout.layer1,
+            "gear D": layout.layer2, "planet gear E": layout.layer2}
+    for layer, (key, _, _, names) in zip((1, 0), TRAIN1_SETS):   # set I below, set II above
+        radii = train1_set_radii(mechanism, key)
+        for k, name in enumerate(names):
+            # the sun turns at -(n - 1) phi in the carrier; each mesh reverses the sense:
+            # idler A +, idler B -, planet + (set II's +2 phi: -phi + 2 phi = +phi, gearbox 2's
+            # turn; set I's +phi: it stays still), each times r_sun / r
+            sign = -1.0 if k % 2 == 0 else 1.0
+            ratio = radii[0] / radii[k]
+            relative[name] = lambda phi, sign=sign, ratio=ratio: sign * (n - 1) * phi * ratio
+            z_of[name] = layout.box1_layers[layer]
+    drive = getattr(train, "drive", None)
+    if drive is not None:
+        z1, z2, z3, z4 = drive.teeth
+        relative["input gear 1"] = lambda phi: n * phi * z2 / z1
+        relative["input gear 2"] = lambda phi: phi * z4 / z3
+        frame = layout.frame_layers
+        z_of.update({"input gear 1": frame[0], "central shaft gear": frame[0],
+                     "input gear 2": frame[1], "transmission driven gear": frame[1]})
+    in_box2 = {"central", "intermediate", "gear D", "planet gear E"}
+    on_frame = {"input gear 1", "input gear 2"}
     start = body_poses(mechanism, layout)
     parts, frames = [], {}
     for profile, angle, centre in _placements(train):
-        body = "gearbox2" if profile.name in in_box2 else "carrier1"
-        circular = profile.name not in ("central", "intermediate")
-        face = layout.face_c if circular else layout.face_nc
-        z = in_box2.get(profile.name, layout.layer0)
+        body = ("gearbox2" if profile.name in in_box2 else
+                "frame" if profile.name in on_frame else "carrier1")
+        face = params.gears.face_width_for(profile.module)
+        z = z_of[profile.name]
         # the gear's placement in its body at the catching pose (both from arm 1 at phi = 0)
         world = planar_transform(angle, centre, z)
         local0 = np.linalg.solve(start(body, 0.0), world)
@@ -195,8 +223,10 @@ def _gear_parts(params, mechanism, train, layout, segments):
         instances = (((profile.file_stem + "-arm1", "gearbox2", 0.0),
                       (profile.file_stem + "-arm2", "gearbox2", math.pi))
                      if body == "gearbox2" else
+                     ((profile.file_stem, "frame", 0.0),) if body == "frame" else
                      ((profile.file_stem + "-side1", "carrier1", 0.0),)
-                     if profile.name == "sun" else
+                     if profile.name in ("sun", "sun I", "central shaft gear",
+                                         "transmission driven gear") else
                      ((profile.file_stem + "-side1", "carrier1", 0.0),
                       (profile.file_stem + "-side2", "carrier1:mirrored", 0.0)))
         parts.append(Part(profile.file_stem, "gear", body, solid, local, instances, outline))
@@ -253,7 +283,98 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
                 instances += ((f"{stem}-side2", "carrier1:mirrored", 0.0),)
             parts.append(shaft_part(shaft, housing1, "carrier1", instances=instances,
                                     segments=segments, gears=gears))
-    return parts, (housing1, housing2)
+    housings = (housing1, housing2)
+    if "frame" in drivetrain.stacks:
+        frame, frame_parts = _frame_parts(params, mechanism, drivetrain, layout, segments, gears)
+        parts += frame_parts
+        housings += (frame,)
+    parts = _drilled(parts, drivetrain, layout, segments)
+    return parts, housings
+
+
+#: A tapped hole's drill for the carrying flanges' screws (ISO 2306, M6: 5.0 mm).
+TAP_DRILL = {"M5": 4.2, "M6": 5.0, "M8": 6.8}
+
+
+def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
+    """The frame (the transmission box): a split housing round the drive's two pairs, fixed,
+    with its shafts (the central shaft O, the sleeve S carrying gearbox 1, the input)."""
+    from cadgen.solids.housings import ShellSize, flange_width
+    from cadgen.solids.machine_parts import housing_parts, shaft_part, stack_housing
+
+    drive = drivetrain.drive
+    module = drive.module_1
+    housing = params.housing
+    wall = housing.wall_for(module)
+    shell = ShellSize(housing.clearance_for(module), wall, housing.axial_gap, module,
+                      flange_width(params, wall))
+    tip = [r + module for r in drive.radii]
+    discs = [(0.0, 0.0, max(tip[1], tip[3])), (-drive.centre_distance, 0.0, max(tip[0], tip[2]))]
+    frame = stack_housing(params, discs, shell, drivetrain.stacks["frame"],
+                          drivetrain.seats("frame"), z_cavity_bottom=layout.frame_floor,
+                          segments=segments, path="housing.frame")
+    parts = housing_parts("frame", frame, "frame")
+    for shaft in drivetrain.shafts:
+        if shaft.housing != "frame":
+            continue
+        body = "frame" if shaft.name == "input" else "carrier1"
+        stem = f"shaft-{shaft.name}"
+        parts.append(shaft_part(shaft, frame, body, instances=((stem, body, 0.0),),
+                                segments=segments, gears=gears))
+    return frame, parts
+
+
+def _drilled(parts, drivetrain, layout, segments):
+    """Holes the seats do not make: where a shaft passes a floor with no bearing of its own
+    (O through gearbox 1's, C2 through gearbox 2's) and the tapped holes of the flanges that
+    carry gearbox 1 (the sleeve S) and gearbox 2 (the hollow shaft C)."""
+    from dataclasses import replace as _replace
+
+    from cadgen.solids.extrude import manifold3d_engine
+    from cadgen.solids.machine_parts import flange_bolt_holes
+
+    m3d = manifold3d_engine()
+    by = {(s.name, s.side): s for s in drivetrain.shafts}
+    cuts = {}
+    clearance = drivetrain.rules.get("fits", {}).get("running_clearance_mm", 1.0)
+
+    def add(part, solid):
+        cuts[part] = solid if part not in cuts else cuts[part] + solid
+
+    floor1 = (layout.box1_floor - layout.box1_floor_wall, layout.box1_floor)
+    floor2 = (layout.box2_floor - layout.box2_floor_wall, layout.box2_floor)
+    for (name, side), shaft in by.items():
+        if side != 1:
+            continue
+        if name == "O":
+            z0, z1 = floor1
+            add("gearbox1-base", m3d.Manifold.cylinder(z1 - z0 + 2, (shaft.diameter + clearance)
+                                                       / 2, (shaft.diameter + clearance) / 2,
+                                                       segments).translate((0, 0, z0 - 1)))
+        if name == "C2":
+            z0, z1 = floor2
+            add("gearbox2-base", m3d.Manifold.cylinder(z1 - z0 + 2, (shaft.diameter + clearance)
+                                                       / 2, (shaft.diameter + clearance) / 2,
+                                                       segments).translate((0, 0, z0 - 1)))
+        if shaft.flange:
+            target = "gearbox1-base" if shaft.flange["carries"] == "gearbox1" else "gearbox2-base"
+            z0, z1 = floor1 if target == "gearbox1-base" else floor2
+            depth = min(z1 - z0 - 2.0, 2.0 * float(shaft.flange["bolt"].removeprefix("M")))
+            holes = flange_bolt_holes(shaft.flange, depth, segments,
+                                      diameter=TAP_DRILL.get(shaft.flange["bolt"], 5.0))
+            add(target, holes.translate((0, 0, z0)))
+    if not cuts:
+        return parts
+    out = []
+    for part in parts:
+        stem = part.name
+        key = next((k for k in cuts if stem == k or stem.startswith(k + "-")), None)
+        if key is None:
+            out.append(part)
+            continue
+        # gearbox 2's holes are at C, the origin of its body; gearbox 1's at O, its origin
+        out.append(_replace(part, solid=part.solid - cuts[key]))
+    return out
 
 
 def cam_bore_radius(params, drivetrain) -> float:
