@@ -47,3 +47,25 @@ def fcl_bvh(mesh):
                       np.asarray(mesh.faces, dtype=np.int32))
     model.endModel()
     return model
+
+
+def gears_in_their_housings(assembly, housings, phi: float):
+    """``(part, housing name, housing, 4x4 pose in the housing's body)`` of every gear of a
+    planting assembly at carrier angle ``phi``: its housing is the one whose cavity holds its
+    face (the central shaft's and the sleeve's gears turn in the frame though they ride on
+    carrier 1's body), found from the world placements, not from the parts' bodies."""
+    import numpy as np
+
+    bodies = {"gearbox1": "carrier1", "gearbox2": "gearbox2", "frame": "frame"}
+    boxes = dict(zip(("gearbox1", "gearbox2", "frame"), housings))
+    world = {name: pose for name, _, pose in assembly.placements(phi)}
+    for part in assembly.parts:
+        if part.kind != "gear":
+            continue
+        first = part.instances[0] if part.instances else (part.name, part.body, 0.0)
+        pose = world[first[0]]
+        middle = pose[2, 3] + float(part.mesh.bounds[:, 2].mean())
+        name = next(n for n, h in boxes.items()
+                    if h.z_cavity_bottom <= middle <= h.z_cavity_bottom + h.cavity_height)
+        yield part, name, boxes[name], np.linalg.solve(
+            assembly.body_pose(bodies[name], phi + first[2]), pose)

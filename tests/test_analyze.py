@@ -20,21 +20,27 @@ def test_writes_report_and_plots(params, tmp_path):
     plots = sorted(p.name for p in (folder / "plots").iterdir())
     assert [p for p in plots if not p.startswith("gears-")] == [
         "absolute_paths.png", "assembly.png", "attitude.png", "cam-contour.png", "cam-follower.png",
-        "housing-gearbox1.png", "housing-gearbox2.png", "pitch_curves.png", "relative_path.png",
-        "tip_velocity.png"]
-    assert len([p for p in plots if p.startswith("gears-")]) == 5   # one picture per pair
+        "housing-frame.png", "housing-gearbox1.png", "housing-gearbox2.png", "pitch_curves.png",
+        "relative_path.png", "tip_velocity.png"]
+    # one picture per pair: gearbox 2's two, train 1's two sets of three, the drive's two
+    assert len([p for p in plots if p.startswith("gears-")]) == 2 + 3 + 3 + 2
     dxf = sorted(p.name for p in (folder / "gears").iterdir())
-    assert dxf == ["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf", "intermediate.dxf",
-                   "planet-gear-E.dxf", "sun.dxf", "train-1-planet.dxf", "train.dxf"]
+    new_gears = ("sun-I", "idler-1-I", "idler-2-I", "planet-I", "input-gear-1",
+                 "central-shaft-gear", "input-gear-2", "transmission-driven-gear")
+    assert dxf == sorted(["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf",
+                          "intermediate.dxf", "planet-gear-E.dxf", "sun.dxf", "train-1-planet.dxf",
+                          "train.dxf", *(f"{gear}.dxf" for gear in new_gears)])
     assert (folder / "cam.dxf").is_file()
     solids = sorted(p.name for p in (folder / "solids").iterdir())
     assert solids == sorted(["assembly.glb", "blade-left.stl", "blade-right.stl", "cam.stl",
                              "central.stl", "gear-D.stl", "gearbox1-base.stl",
                              "gearbox1-cover.stl", "gearbox2-base.stl", "gearbox2-cover.stl",
-                             *(f"shaft-{axis}.stl" for axis in ("O", "A", "B", "C", "C2", "D", "E")),
+                             *(f"shaft-{axis}.stl" for axis in ("O", "A", "B", "C", "C2", "D", "E",
+                                                                "S", "input")),
                              "ground.stl", "idler-1.stl", "idler-2.stl", "intermediate.stl",
                              "planet-gear-E.stl", "planter-shell.stl", "sun.stl",
-                             "train-1-planet.stl"])
+                             "train-1-planet.stl", "frame-base.stl", "frame-cover.stl",
+                             *(f"{gear}.stl" for gear in new_gears)])
     report = json.loads((folder / "report.json").read_text())
     assert report["cam"]["cuttable"] and report["cam"]["problems"] == []
     assert all(row["gears_enclosed"] for row in report["solids"]["enclosure"])

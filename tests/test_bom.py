@@ -57,8 +57,13 @@ def test_two_bearings_per_shaft_and_their_bores_are_the_shafts(built):
     shafts = [r for r in rows if r["source"] == "make" and r["part"].startswith("shaft-")]
     placed_shafts = sum(_instances(scene, r["part"]) for r in shafts)
     bearings = [r for r in rows if r["part"] == "bearing"]
-    assert sum(int(r["quantity"]) for r in bearings) == 2 * placed_shafts
     machine = result.report["machine"]
+    # and two in the hub of each gear that runs free on its shaft (set I's idlers), per copy
+    free = [h["gear"].replace(" ", "-") for s in machine["shafts"] if s["side"] == 1
+            for h in s["hubs"] if h.get("runs_free_on")]
+    assert len(free) == 2
+    placed_free = sum(_instances(scene, gear) for gear in free)
+    assert sum(int(r["quantity"]) for r in bearings) == 2 * placed_shafts + 2 * placed_free
     diameters = {(s["name"], s["side"]): s["diameter_mm"] for s in machine["shafts"]}
     for bearing in machine["bearings"]:
         assert bearing["d_mm"] == diameters[bearing["shaft"], bearing["side"]]
@@ -86,22 +91,29 @@ def test_bolts_nuts_and_washers_match_the_holes_in_the_flanges(built):
     for r in rows:
         if r["part"] == "socket head cap screw":
             screws[r["designation"].split()[2]] += int(r["quantity"])   # "ISO 4762 M3 x 16 - 8.8"
-    for housing in ("gearbox1", "gearbox2"):
+    for housing, thread in (("gearbox1", "M3"), ("gearbox2", "M4"), ("frame", "M3")):
         path = folder / "solids" / f"{housing}-base.stl"
         # the base lies on its floor in its printing pose: its flange is at the top, below the
         # parting plane; cut it half a flange below its top face
         mesh = trimesh.load(path)
         top = float(mesh.bounds[1, 2])
-        thread = "M3" if housing == "gearbox1" else "M4"
         diameter = clearance_hole(thread, fits.bolt_hole_series) + fits.bolt_hole_extra
         found = _bolt_holes(path, top - 0.5, diameter)
         assert found >= 4
         holes[thread] += found * _instances(scene, f"{housing}-base")
+    flange_holes = Counter(holes)
+    # the flanges that carry gearbox 1 (the sleeve S) and gearbox 2 (the hollow shaft C) are
+    # screwed into tapped holes (M6: a 5.0 mm drill, ISO 2306) of their floors; cut 1 mm up
+    for housing in ("gearbox1", "gearbox2"):
+        path = folder / "solids" / f"{housing}-base.stl"
+        bottom = float(trimesh.load(path).bounds[0, 2])
+        holes["M6"] += _bolt_holes(path, bottom + 1.0, 5.0) * _instances(scene, f"{housing}-base")
+    assert holes["M6"] == 6 + 2 * 6      # 6 screws on S, 6 on each arm's C
     assert screws == holes
     nuts = Counter(r["designation"].split()[2] for r in rows if r["part"] == "hexagon nut"
                    for _ in range(int(r["quantity"])))
     washers = sum(int(r["quantity"]) for r in rows if r["part"] == "plain washer")
-    assert nuts == holes and washers == 2 * sum(holes.values())
+    assert nuts == flange_holes and washers == 2 * sum(flange_holes.values())
 
 
 def test_keys_one_per_keyed_gear_placed(built):
@@ -109,7 +121,10 @@ def test_keys_one_per_keyed_gear_placed(built):
     keyed = [h["gear"].replace(" ", "-") for s in result.report["machine"]["shafts"]
              if s["side"] == 1 for h in s["hubs"] if h.get("key")]
     expected = sum(_instances(scene, gear) for gear in keyed)
-    assert sum(int(r["quantity"]) for r in rows if r["part"] == "key") == expected > 0
+    # and the input shaft's stub, keyed for the sprocket or coupling
+    couplings = [s for s in result.report["machine"]["shafts"] if s["coupling_key"]]
+    assert [s["name"] for s in couplings] == ["input"]
+    assert sum(int(r["quantity"]) for r in rows if r["part"] == "key") == expected + 1 > 1
 
 
 def test_each_gear_sits_on_its_shaft_axis(built):
@@ -127,16 +142,24 @@ def test_each_gear_sits_on_its_shaft_axis(built):
                                        0.0, drivetrain=shafts)
     parts = {p.name: p for p in assembly.parts}
     checked = 0
-    for shaft in shafts.shafts:
-        if shaft.side != 1:
-            continue
-        axis = parts[f"shaft-{shaft.name}"].local(0.0)[:2, 3]
-        for mount in shaft.mounts:
-            gear = parts[mount.gear.replace(" ", "-")]
-            assert gear.body == parts[f"shaft-{shaft.name}"].body
-            np.testing.assert_allclose(gear.local(0.0)[:2, 3], axis, atol=1e-9)
-            checked += 1
-    assert checked == 8
+    for phi in (0.0, 1.3):
+        world = {name: pose for name, _, pose in assembly.placements(phi)}
+        for shaft in shafts.shafts:
+            if shaft.side != 1:
+                continue
+            axis = world[_first(parts[f"shaft-{shaft.name}"])][:2, 3]
+            for mount in shaft.mounts:
+                # a gear may turn in another housing than its shaft's (the central gear on C2
+                # in gearbox 2): compared in the world
+                gear = world[_first(parts[mount.gear.replace(" ", "-")])]
+                np.testing.assert_allclose(gear[:2, 3], axis, atol=1e-9)
+                checked += 1
+    assert checked == 2 * 16
+
+
+def _first(part) -> str:
+    """The first placed copy's instance name of a part (side 1, arm 1, or its own name)."""
+    return part.instances[0][0] if part.instances else part.name
 
 
 def test_each_shaft_stl_is_as_long_as_its_stack_says(built):
@@ -145,9 +168,11 @@ def test_each_shaft_stl_is_as_long_as_its_stack_says(built):
     _, result, folder, _, _ = built
     for shaft in result.report["machine"]["shafts"]:
         mesh = trimesh.load(folder / "solids" / f"shaft-{shaft['name']}.stl")
-        extents = sorted(mesh.extents)
-        assert extents[2] == pytest.approx(shaft["length_mm"], abs=1e-4)       # float32 STL
-        assert extents[0] == pytest.approx(shaft["diameter_mm"], abs=1e-4)
+        # as long as its stack says, as wide as its diameter or (a hollow shaft carrying a
+        # housing) its flange, whichever extent is the larger
+        width = 2 * shaft["flange"]["radius"] if shaft["flange"] else shaft["diameter_mm"]
+        assert sorted(mesh.extents) == pytest.approx(sorted([shaft["length_mm"], width, width]),
+                                                     abs=1e-4)       # float32 STL
 
 
 def _direction(points) -> float:
@@ -180,19 +205,27 @@ def test_each_keyseat_lies_under_its_gears_keyway_at_every_pose(built):
         part = parts[f"shaft-{shaft.name}"]
         vertices = part.mesh.vertices
         radius = np.linalg.norm(vertices[:, :2], axis=1)
+        inner = shaft.bore / 2 + 1e-6   # a hollow shaft's bore is not its keyseat
         for mount in shaft.mounts:
             key = mount.key
+            if key is None:   # a gear running free on its bearings: no keyseat
+                continue
             gear = parts[mount.gear.replace(" ", "-")]
-            z0 = gear.local(0.0)[2, 3]
+            world0 = {name: pose for name, _, pose in assembly.placements(0.0)}
+            # the gear's face from the shaft's own frame: world heights less the shaft's
+            z0 = world0[_first(gear)][2, 3] - world0[_first(part)][2, 3]
             inside = (vertices[:, 2] > z0 - 1e-6) & (vertices[:, 2] < z0 + mount.face_width + 1e-6)
-            seat = vertices[inside & (radius < shaft.diameter / 2 - key.shaft_depth / 2), :2]
+            seat = vertices[inside & (radius < shaft.diameter / 2 - key.shaft_depth / 2)
+                            & (radius > inner), :2]
             hole = holes[mount.gear]
             keyway = hole[np.linalg.norm(hole, axis=1) > mount.hub_bore / 2 + key.hub_depth / 2]
             assert len(seat) and len(keyway)
             for phi in (0.0, 1.3, 4.0):
-                turn_shaft = math.atan2(part.local(phi)[1, 0], part.local(phi)[0, 0])
-                turn_gear = math.atan2(gear.local(phi)[1, 0], gear.local(phi)[0, 0])
+                world = {name: pose for name, _, pose in assembly.placements(phi)}
+                shaft_pose, gear_pose = world[_first(part)], world[_first(gear)]
+                turn_shaft = math.atan2(shaft_pose[1, 0], shaft_pose[0, 0])
+                turn_gear = math.atan2(gear_pose[1, 0], gear_pose[0, 0])
                 gap = (turn_shaft + _direction(seat)) - (turn_gear + _direction(keyway))
                 assert abs(math.remainder(gap, 2 * math.pi)) < 1e-9, (shaft.name, mount.gear, phi)
             checked += 1
-    assert checked == 8
+    assert checked == 16 - 2     # every keyed gear (set I's two idlers run free)

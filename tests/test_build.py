@@ -248,7 +248,7 @@ def test_dxf_asked_alone_writes_the_gears_as_the_teeth_effect_cuts_them(params, 
     alone = build(params, tmp_path / "alone", effects=["dxf"], cache=False)
     with_teeth = build(params, tmp_path / "teeth", effects=["teeth", "dxf"], cache=False)
     files = {p.name: p.read_bytes() for p in (alone.output_dir / "gears").iterdir()}
-    assert len(files) == 9 and "train.dxf" in files
+    assert len(files) == 16 + 1 and "train.dxf" in files    # every gear and the train sheet
     assert files == {p.name: p.read_bytes() for p in (with_teeth.output_dir / "gears").iterdir()}
     assert (alone.output_dir / "cam.dxf").is_file()
 

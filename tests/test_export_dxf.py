@@ -433,7 +433,8 @@ def test_train_sheet_bad_placements(tmp_path, star):
 # --------------------------------------------------------------------------- what CAM programs see
 
 PLANTING_FILES = ["central", "intermediate", "gear-D", "planet-gear-E", "sun", "idler-1", "idler-2",
-                  "train-1-planet", "train", "cam"]
+                  "train-1-planet", "sun-I", "idler-1-I", "idler-2-I", "planet-I", "input-gear-1",
+                  "central-shaft-gear", "input-gear-2", "transmission-driven-gear", "train", "cam"]
 
 
 @pytest.fixture(scope="module")
@@ -520,21 +521,26 @@ def _shift(title) -> float:
 def test_train_sheet_draws_each_gear_plane_apart(planting_dxf):
     doc = ezdxf.readfile(planting_dxf["train"])
     views = _views(doc)
-    assert [names for _, names in views] == [{"central", "intermediate"}, {"gear D", "planet gear E"},
-                                             {"sun", "idler 1", "idler 2", "train-1 planet"}]
-    assert [title.split(" (")[0] for title, _ in views] == [f"gear plane {k} of 3" for k in (1, 2, 3)]
+    assert [names for _, names in views] == [
+        {"central", "intermediate"}, {"gear D", "planet gear E"},
+        {"sun", "idler 1", "idler 2", "train-1 planet"},
+        {"sun I", "idler 1-I", "idler 2-I", "planet I"},
+        {"input gear 1", "central shaft gear"}, {"input gear 2", "transmission driven gear"}]
+    assert [title.split(" (")[0] for title, _ in views] == [f"gear plane {k} of 6"
+                                                            for k in range(1, 7)]
     shifts = [_shift(title) for title, _ in views]
     assert shifts[0] == 0 and all(s % 10 == 0 for s in shifts) and shifts == sorted(set(shifts))
     outlines = [shapely.Polygon(e.get_points(format="xy")) for e in _entities(doc, "OUTLINE", "LWPOLYLINE")]
-    assert len(outlines) == 8
+    assert len(outlines) == 16
     # gears meshing touch at most by the meshing check's overlap; gears on one shaft would cover
     # each other by thousands of mm^2
     for first, second in zip(*np.triu_indices(len(outlines), 1)):
         assert outlines[first].intersection(outlines[second]).area < 0.01
-    # every shaft (6 of them) marked once in each of the 3 views: no two marks at one place
+    # every shaft (7 of them: O, A, B, C, D, E and the drive's input) marked once in each of the
+    # 6 views: no two marks at one place
     crossings = {tuple(np.round((_xy(line.dxf.start) + _xy(line.dxf.end)) / 2, 6))
                  for line in _entities(doc, CENTRE_LAYER, "LINE")}
-    assert len(crossings) == 3 * 6 == len(_entities(doc, CENTRE_LAYER, "LINE")) / 2
+    assert len(crossings) == 6 * 7 == len(_entities(doc, CENTRE_LAYER, "LINE")) / 2
     # the labels sit inside their gears, clear of every other outline
     for label in _entities(doc, LABEL_LAYER, "TEXT"):
         box = shapely.box(*_text_box(label).ravel())

@@ -19,6 +19,10 @@ PAPER = REPO / "params" / "xin2024-planter.toml"
 #: What the byte-for-byte comparison covers: every cut gear's DXF and the pitch curves.
 EFFECTS = ["teeth", "dxf", "curves"]
 
+#: The paper's gear pairs, each one cached stage: gearbox 2's two, train 1's two sets of three,
+#: the frame's drive's two.
+PAIRS = 2 + 2 * 3 + 2
+
 
 @pytest.fixture(scope="module")
 def paper():
@@ -51,18 +55,18 @@ def uncached(paper, tmp_path_factory):
 def test_cached_builds_write_the_bytes_an_uncached_build_writes(paper, uncached, tmp_path):
     cache = tmp_path / "cache"
     cold, cold_files = _build(paper, tmp_path / "cold", cache)
-    assert cold == {"used": True, "directory": str(cache), "hits": 0, "misses": 5}
+    assert cold == {"used": True, "directory": str(cache), "hits": 0, "misses": PAIRS}
     warm, warm_files = _build(paper, tmp_path / "warm", cache)
-    assert (warm["hits"], warm["misses"]) == (5, 0)
+    assert (warm["hits"], warm["misses"]) == (PAIRS, 0)
     assert cold_files.keys() == warm_files.keys() == uncached.keys()
     for name, data in uncached.items():
         assert cold_files[name] == data, name
         assert warm_files[name] == data, name
-    # five stages, the bytes of every gear file (one per gear and the train sheet) and each
+    # every pair's stage, the bytes of every gear file (one per gear and the train sheet) and each
     # gear's cutting outline
     dxf = [name for name in uncached if name.startswith("gears/")]
-    assert len(_stage_entries(cache)) == 5
-    assert GearCache(cache).stats()[0] == 5 + len(dxf) + (len(dxf) - 1)
+    assert len(_stage_entries(cache)) == PAIRS
+    assert GearCache(cache).stats()[0] == PAIRS + len(dxf) + (len(dxf) - 1)
 
 
 def _stage_entries(cache: Path) -> list:
@@ -91,12 +95,12 @@ def test_a_warm_build_writes_the_gear_files_without_making_them(paper, uncached,
     assert files == uncached
 
 
-_WARM_CAM_BUILD = """
+_WARM_CAM_BUILD = f"""
 import sys
 import cadgen
 params = cadgen.load_params(sys.argv[1])
 result = cadgen.build(params, sys.argv[2], effects=["teeth", "cam", "dxf"], cache=sys.argv[3])
-assert (result.report["gear_cache"]["hits"], result.report["gear_cache"]["misses"]) == (5, 0)
+assert (result.report["gear_cache"]["hits"], result.report["gear_cache"]["misses"]) == ({PAIRS}, 0)
 print("ezdxf" in sys.modules)
 """
 
@@ -118,7 +122,7 @@ def test_a_warm_build_writes_the_cam_file_without_loading_ezdxf(paper, tmp_path)
     cam = [(folder / paper.name / "cam.dxf").read_bytes()
            for folder in (tmp_path / "uncached", tmp_path / "cold", tmp_path / "warm")]
     assert cam[0] == cam[1] == cam[2] and cam[0].startswith(b"  0\nSECTION")
-    assert alone.report["gear_cache"]["used"] is False and cold.report["gear_cache"]["misses"] == 5
+    assert alone.report["gear_cache"]["used"] is False and cold.report["gear_cache"]["misses"] == PAIRS
 
 
 def test_a_warm_build_thins_no_gear_outline_again(paper, tmp_path, monkeypatch):
@@ -143,7 +147,7 @@ def test_a_warm_build_thins_no_gear_outline_again(paper, tmp_path, monkeypatch):
     monkeypatch.setattr(contour, "thin_outline", never_a_gear(contour.thin_outline))
     monkeypatch.setattr(contour, "thin_ring", never_a_gear(contour.thin_ring))
     warm = cadgen.build(paper, tmp_path / "warm", effects=effects, cache=cache)
-    assert (warm.report["gear_cache"]["hits"], warm.report["gear_cache"]["misses"]) == (5, 0)
+    assert (warm.report["gear_cache"]["hits"], warm.report["gear_cache"]["misses"]) == (PAIRS, 0)
     cold_files = {f.relative_to(cold.output_dir): f.read_bytes()
                   for f in sorted(cold.output_dir.rglob("*")) if f.is_file()}
     warm_files = {f.relative_to(warm.output_dir): f.read_bytes()
@@ -221,7 +225,7 @@ def test_a_loaded_stage_equals_the_computed_one_in_every_array(paper, tmp_path):
     cache = GearCache(tmp_path)
     computed = planting_train(paper, mechanism, cache=cache)
     loaded = planting_train(paper, mechanism, cache=cache)
-    assert (cache.hits, cache.misses) == (5, 5)
+    assert (cache.hits, cache.misses) == (PAIRS, PAIRS)
     for a, b in zip(computed.stages, loaded.stages, strict=True):
         # the pair's contact functions are closures (each train makes its own): the loaded
         # stage has the caller's pair, and every other field equal
@@ -239,8 +243,8 @@ def test_a_grid_over_the_planter_length_recuts_no_gear(paper, tmp_path):
     cache = tmp_path / "cache"
     first, _ = _build(paper, tmp_path / "190", cache)
     second, _ = _build(shorter, tmp_path / "180", cache)
-    assert (first["hits"], first["misses"]) == (0, 5)
-    assert (second["hits"], second["misses"]) == (5, 0)
+    assert (first["hits"], first["misses"]) == (0, PAIRS)
+    assert (second["hits"], second["misses"]) == (PAIRS, 0)
 
 
 def test_a_key_changes_with_what_determines_the_stage():
@@ -304,7 +308,7 @@ def test_a_bad_entry_is_a_miss_and_the_build_recomputes_it(paper, uncached, tmp_
     cache = tmp_path / "cache"
     _build(paper, tmp_path / "cold", cache)
     entries = _stage_entries(cache)
-    assert len(entries) == 5
+    assert len(entries) == PAIRS
     victim = entries[0]
     data = victim.read_bytes()
     if damage == "truncated":
@@ -318,7 +322,7 @@ def test_a_bad_entry_is_a_miss_and_the_build_recomputes_it(paper, uncached, tmp_
     assert not victim.exists()      # deleted, so the next build stores a good one
     victim.write_bytes(b"CGGEAR")   # shorter than a header: unreadable, still no exception
     record, files = _build(paper, tmp_path / "again", cache)
-    assert (record["hits"], record["misses"]) == (4, 1)
+    assert (record["hits"], record["misses"]) == (PAIRS - 1, 1)
     assert files == uncached
     assert GearCache(cache).get(victim.stem) is not None   # recomputed and stored again
 
@@ -386,10 +390,10 @@ def test_cache_clear_and_info_on_the_command_line(paper, tmp_path, monkeypatch, 
     assert result.report["gear_cache"]["directory"] == str(cache)
     assert main(["cache", "info"]) == 0
     out = capsys.readouterr().out
-    assert str(cache) in out and "entries:   5" in out
+    assert str(cache) in out and f"entries:   {PAIRS}" in out
     assert main(["cache", "clear"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("removed 5 gear cache entries (") and str(cache) in out
+    assert out.startswith(f"removed {PAIRS} gear cache entries (") and str(cache) in out
     assert cache.is_dir() and not list(cache.iterdir())
     assert cadgen.cache_info()["entries"] == 0
     assert main(["cache", "clear"]) == 0 and "removed 0 " in capsys.readouterr().out

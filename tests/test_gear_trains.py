@@ -24,7 +24,7 @@ def planting():
 def test_every_planting_mesh_runs_its_cycle_without_interference(planting):
     _, train = planting
     report = train_report(train)
-    assert len(report["meshes"]) == 5 and not report["failures"]
+    assert len(report["meshes"]) == 10 and not report["failures"]
     teeth = {g["gear"]: g["teeth"] for g in report["gears"]}
     for mesh in report["meshes"]:
         module = [g for g in train.stages if g.name == mesh["stage"]][0].generated.system.module

@@ -183,7 +183,11 @@ def test_every_seat_fits_its_shaft_and_the_process(bundled):
     for shaft in train.shafts:
         assert shaft.diameter in preferred_diameters() and not shaft.given
         assert shaft.strength_passed
-        assert len(shaft.seats) == 2 and [s.wall for s in shaft.seats] == ["floor", "roof"]
+        if shaft.flange:   # a hollow shaft carrying a housing: a bearing pair in one seat
+            assert [(s.wall, s.count) for s in shaft.seats] == [("roof", 2)]
+            assert shaft.bore > 0 and shaft.diameter - shaft.bore >= 4.0
+        else:
+            assert len(shaft.seats) == 2 and [s.wall for s in shaft.seats] == ["floor", "roof"]
         for seat in shaft.seats:
             assert seat.bearing.bore == shaft.diameter
             assert seat.seat_diameter == pytest.approx(
@@ -192,13 +196,18 @@ def test_every_seat_fits_its_shaft_and_the_process(bundled):
                                           if seat.through else 0.0)
             assert seat.life_passed
         for mount in shaft.mounts:
+            if mount.bearing is not None:   # a gear running free on two bearings
+                assert mount.bearing.bore == shaft.diameter and mount.key is None
+                assert mount.hub_bore == mount.bearing.outside
+                assert 2 * mount.bearing.width <= mount.face_width
+                continue
             assert mount.hub_bore == shaft.diameter
             if shaft.diameter >= 10:
                 assert mount.key is not None and mount.key.length <= mount.face_width
     for name, stack in train.stacks.items():
         for seat in train.seats(name):
             wall = stack.floor_wall if seat.wall == "floor" else stack.roof_wall
-            assert wall >= seat.bearing.width + 2.0
+            assert wall >= seat.count * seat.bearing.width + 2.0
     report = drivetrain_report(train)
     json.dumps(report)
     # the bundled designs' faces are wide enough for their keys: no check fails
@@ -212,25 +221,40 @@ def test_planting_names_positions_and_stack():
     train = drivetrain(params, mechanism)
     assert {m.gear for s in train.shafts for m in s.mounts} == {
         "central", "intermediate", "gear D", "planet gear E", "sun", "idler 1", "idler 2",
-        "train-1 planet"}
+        "train-1 planet", "sun I", "idler 1-I", "idler 2-I", "planet I", "input gear 1",
+        "central shaft gear", "input gear 2", "transmission driven gear"}
     assert sorted((s.name, s.side) for s in train.shafts) == sorted(
-        [("O", 1), ("A", 1), ("A", 2), ("B", 1), ("B", 2), ("C", 1), ("C", 2), ("C2", 1),
-         ("D", 1), ("E", 1)])
+        [("O", 1), ("S", 1), ("input", 1), ("A", 1), ("A", 2), ("B", 1), ("B", 2), ("C", 1),
+         ("C", 2), ("C2", 1), ("C2", 2), ("D", 1), ("E", 1)])
     shaft, mount = train.shaft_of_gear("planet gear E")
     a, r = mechanism.centre_distance, mechanism.r
     assert shaft.name == "E" and shaft.xy == pytest.approx((a + 2 * r, 0.0))
     c2 = next(s for s in train.shafts if s.name == "C" and s.side == 2)
     assert c2.xy == pytest.approx((0.0, -mechanism.carrier_radii["C"]), abs=1e-9)
     # by hand from the file: faces 25 mm (gears.face_width), gaps 2 mm (housing.axial_gap);
-    # gearbox 1 one layer, gearbox 2 two, a gap below, between and above the layers
+    # gearbox 1 two layers (set I, set II), gearbox 2 two, the frame two (the drive's pairs),
+    # a gap below, between and above the layers
     face, gap = params.gears.face_width, params.housing.axial_gap
     assert (face, gap) == (25.0, 2.0)
-    assert train.stacks["gearbox1"].cavity_height == pytest.approx(face + 2 * gap)
-    assert train.stacks["gearbox2"].cavity_height == pytest.approx(2 * face + 3 * gap)
+    for housing in ("gearbox1", "gearbox2", "frame"):
+        assert train.stacks[housing].cavity_height == pytest.approx(2 * face + 3 * gap)
     assert mount.z_bottom == pytest.approx(2 * gap + face)     # gear E in the second layer
+    # the input shaft's stub leaves the frame's floor for a sprocket or coupling, keyed
+    drive = next(s for s in train.shafts if s.name == "input")
+    assert drive.extends_below == 2 * drive.diameter + 20 and drive.seats[0].through
+    assert drive.coupling_key is not None and drive.coupling_key.length <= drive.extends_below - 4
+    # O: in the frame's floor and gearbox 1's roof, both blind; it passes gearbox 1's floor
     o = next(s for s in train.shafts if s.name == "O")
-    assert o.extends_below == 2 * o.diameter + 20 and o.seats[0].through
-    assert not o.seats[1].through
+    assert [(seat.housing, seat.wall, seat.through) for seat in o.seats] == [
+        ("frame", "floor", False), ("gearbox1", "roof", False)]
+    # the inner shaft C2: from gearbox 1's floor to gearbox 2's roof, its z range from the
+    # stack: gearbox 2's cavity floor above gearbox 1's plus gearbox 2's cavity and roof bearing
+    inner = next(s for s in train.shafts if s.name == "C2" and s.side == 1)
+    assert [(seat.housing, seat.wall) for seat in inner.seats] == [("gearbox1", "floor"),
+                                                                   ("gearbox2", "roof")]
+    top = train.bases["gearbox2"] + train.stacks["gearbox2"].cavity_height + \
+        inner.seats[1].bearing.width
+    assert inner.ends == pytest.approx((-inner.seats[0].bearing.width, top))
     assert shaft.extends_above == pytest.approx(2 * params.housing.axial_gap + params.cam.thickness
                                                 + params.planter.arm_thickness)
 
@@ -238,8 +262,11 @@ def test_planting_names_positions_and_stack():
 def test_planting_speeds_follow_the_train():
     mechanism = build_mechanism(load_params(PAPER))
     speeds = planting_speeds(mechanism, 30.0)
-    assert speeds["O"] == 60.0 and speeds["C"] == 60.0            # (n - 1) omega, n = 3
+    # O turns at n omega in the frame's bearing (its larger relative speed; (n - 1) omega in
+    # gearbox 1's); C, set II's planet, (n - 1) omega R / R in carrier 1; n = 3, omega = 30
+    assert speeds["O"] == 90.0 and speeds["C"] == 60.0
     assert speeds["A"] == pytest.approx(60.0 / 1.2) and speeds["E"] == 30.0
+    assert speeds["S"] == 30.0 and speeds["C2"] == 30.0    # carrier 1 in the frame; planet I
 
 
 def test_pricking_gears_turn_once_per_carrier_turn():

@@ -36,7 +36,10 @@ def test_one_gears_shift_gives_its_mate_the_opposite():
     assert shifts.given() == {"intermediate": 0.2}
     assert shifts.resolved() == {"central": -0.2, "intermediate": 0.2, "gear_D": 0.0,
                                  "planet_gear_E": 0.0, "sun": 0.0, "idler_1": 0.0, "idler_2": 0.0,
-                                 "train_1_planet": 0.0}
+                                 "train_1_planet": 0.0, "sun_I": 0.0, "idler_1_I": 0.0,
+                                 "idler_2_I": 0.0, "planet_I": 0.0, "input_gear_1": 0.0,
+                                 "central_shaft_gear": 0.0, "input_gear_2": 0.0,
+                                 "transmission_driven_gear": 0.0}
     assert hash(params)                 # still frozen and hashable (cached kinematics)
 
 

@@ -40,7 +40,7 @@ def _housing_parts(assembly, stem):
 
 
 def test_gearbox1_is_cut_and_gearbox2_is_whole(printed):
-    _, assembly, (box1, box2) = printed
+    _, assembly, (box1, box2, *_) = printed
     names = [p.name for p in assembly.parts if p.kind == "housing"]
     assert [n for n in names if n.startswith("gearbox1")] == [
         "gearbox1-base-1", "gearbox1-base-2", "gearbox1-base-3",
@@ -66,7 +66,7 @@ def test_every_housing_part_fits_the_build_volume_and_is_watertight(printed):
 def test_the_pieces_make_up_the_half_without_overlapping(printed, half):
     import manifold3d as m3d
 
-    _, assembly, (box1, _) = printed
+    _, assembly, (box1, *_) = printed
     pieces = [p.solid for p in _housing_parts(assembly, f"gearbox1-{half}-")]
     whole = getattr(box1, half)
     # the lugs lie outside the housing's envelope but where they thicken the flange (the same
@@ -85,7 +85,7 @@ def test_the_pieces_make_up_the_half_without_overlapping(printed, half):
 def test_each_splice_bolt_passes_through_both_lugs(printed):
     import manifold3d as m3d
 
-    _, assembly, (box1, _) = printed
+    _, assembly, (box1, *_) = printed
     parts = {p.name: p.solid for p in assembly.parts}
     for index, joint in enumerate(box1.joints):
         assert joint.bolts.shape == (4, 3)          # two bolts per half, one each side
@@ -110,7 +110,7 @@ def test_each_splice_bolt_passes_through_both_lugs(printed):
 
 
 def test_the_cuts_avoid_the_seats_and_are_fewest(printed):
-    params, _, (box1, _) = printed
+    params, _, (box1, *_) = printed
     volume = params.manufacturing.build_volume
     cuts = segment_cuts(box1, volume, margin=1.0)
     assert len(cuts) == 2
@@ -125,9 +125,10 @@ def test_the_cuts_avoid_the_seats_and_are_fewest(printed):
 
 
 def test_the_machined_process_gives_the_two_halves(printed):
-    _, assembly, (box1, box2) = _planting(process='"machined"')
+    _, assembly, (box1, box2, *_) = _planting(process='"machined"')
     names = [p.name for p in assembly.parts if p.kind == "housing"]
-    assert names == ["gearbox1-base", "gearbox1-cover", "gearbox2-base", "gearbox2-cover"]
+    assert names == ["gearbox1-base", "gearbox1-cover", "gearbox2-base", "gearbox2-cover",
+                     "frame-base", "frame-cover"]
     assert box1.joints == () and box2.joints == ()
 
 
@@ -138,11 +139,15 @@ def test_a_build_volume_too_small_for_any_split_is_named():
     assert problems and all(p.path == "manufacturing.build_volume" for p in problems)
     assert "cannot split gearbox1 between its bearing seats to fit the build volume" in \
         problems[0].message
-    assert " x 43.0 mm" in problems[0].message      # the best piece's size is listed
+    # the best piece's size is listed: its height is gearbox 1's base, floor wall plus cavity
+    # (the cover is a lid), from the drivetrain's stack
+    params = validate_text(with_keys(reference_text(), "manufacturing", process='"printed"'))
+    stack = drivetrain(params, build_mechanism(params)).stacks["gearbox1"]
+    assert f" x {stack.floor_wall + stack.cavity_height:.1f} mm" in problems[0].message
 
 
 def test_a_cut_through_a_seat_is_a_design_error(printed):
-    _, _, (box1, _) = printed
+    _, _, (box1, *_) = printed
     seat = box1.seats[0]
     with pytest.raises(DesignError) as caught:
         segment_housing(box1, [(seat.xy, (1.0, 0.0))], segments=32, name="gearbox1")
@@ -157,7 +162,7 @@ def test_a_cut_through_a_seat_is_a_design_error(printed):
     ([((0.0, 120.0), (1.0, 0.0))], 2),                                    # too few sides
 ], ids=["not-parallel", "misses", "no-direction", "segments"])
 def test_bad_cuts_are_refused(printed, cuts, segments):
-    _, _, (box1, _) = printed
+    _, _, (box1, *_) = printed
     with pytest.raises(SolidInputError):
         segment_housing(box1, cuts, segments=segments)
 
@@ -166,7 +171,7 @@ def test_bad_cuts_are_refused(printed, cuts, segments):
                                             ((256, 256, 256), -1.0)],
                          ids=["two-sizes", "negative", "negative-margin"])
 def test_bad_build_volumes_are_refused(printed, volume, margin):
-    _, _, (box1, _) = printed
+    _, _, (box1, *_) = printed
     with pytest.raises(SolidInputError):
         segment_cuts(box1, volume, margin=margin)
 
@@ -176,10 +181,10 @@ def test_the_rest_of_the_pipeline_sees_the_segments(printed):
     from cadgen.pipeline.clearances import _present
     from cadgen.report.bom import _bought_rows, _copies
 
-    params, assembly, (box1, box2) = printed
+    params, assembly, (box1, box2, *_) = printed
     housings = {"gearbox1": box1, "gearbox2": box2}
     assert [r["housing"] for r in enclosure_checks(assembly, housings)] == ["gearbox1", "gearbox2"]
-    assert _copies(assembly) == {"gearbox1": 1, "gearbox2": 2}
+    assert _copies(assembly) == {"gearbox1": 1, "gearbox2": 2, "frame": 1}
     assert material_key("gearbox1-cover-2", "housing") == "housing-cover"
     assert material_key("gearbox1-base-2", "housing") == "housing"
     parts = {p.name: p for p in assembly.parts}

@@ -89,17 +89,16 @@ def test_gears_with_a_bore_keep_it(planting):
 
 
 def test_planting_housings_enclose_their_gears_checked_with_booleans(planting):
+    from helpers import gears_in_their_housings
+
     *_, assembly, housings, _ = planting
-    box = {"gearbox1": housings[0], "gearbox2": housings[1]}
+    box = dict(zip(("gearbox1", "gearbox2", "frame"), housings))
     for phi in (0.0, 1.234, 4.0):
-        for part in assembly.parts:
-            if part.kind != "gear":
-                continue
-            housing = box["gearbox2" if part.body == "gearbox2" else "gearbox1"]
-            inside, outside = split_encloses(housing, _to_manifold(part, part.local(phi)))
+        for part, _, housing, local in gears_in_their_housings(assembly, housings, phi):
+            inside, outside = split_encloses(housing, _to_manifold(part, local))
             assert inside, (part.name, phi, outside)
             # and they cut neither half of the split housing
-            placed = _to_manifold(part, part.local(phi))
+            placed = _to_manifold(part, local)
             assert (placed ^ housing.base).is_empty() and (placed ^ housing.cover).is_empty()
     report = _solids_outcome(planting[0], assembly, box).enclosure
     assert all(row["gears_enclosed"] for row in report)
@@ -205,10 +204,19 @@ def test_shafts_clear_the_housings_and_the_cam_is_bored_for_e(planting):
     assert set(shafts) == {f"shaft-{s.name}" for s in machine.shafts}
     assert [i[0] for i in shafts["shaft-A"].instances] == ["shaft-A-side1", "shaft-A-side2"]
     assert [i[0] for i in shafts["shaft-E"].instances] == ["shaft-E-arm1", "shaft-E-arm2"]
-    for part in shafts.values():
-        housing = housings[1] if part.body == "gearbox2" else housings[0]
-        placed = _to_manifold(part, part.local(0.0))
-        assert (placed ^ housing.solid).volume() < 1e-6, part.name
+    # in the world, every shaft instance against every housing half placed: a shaft passing
+    # another housing (O through gearbox 1's floor, C2 through gearbox 2's) or bolted to it
+    # (the flanges of S and C) touches none of its material either
+    for phi in (0.0, 2.1):
+        placed = [(name, part, pose) for name, part, pose in assembly.placements(phi)]
+        halves = [(name, _to_manifold(part, pose)) for name, part, pose in placed
+                  if part.kind == "housing"]
+        for name, part, pose in placed:
+            if part.kind != "shaft":
+                continue
+            solid = _to_manifold(part, pose)
+            for other, half in halves:
+                assert (solid ^ half).volume() < 1e-6, (name, other, phi)
     e = next(s for s in machine.shafts if s.name == "E")
     hole = next(seat.hole_diameter for seat in e.seats if seat.wall == "roof")
     cam = next(p for p in assembly.parts if p.name == "cam")

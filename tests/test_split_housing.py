@@ -220,15 +220,13 @@ def test_the_paper_designs_gears_turn_inside_base_and_cover(planting_solids, phi
     from cadgen.solids.split_housing import split_encloses
 
     params, *_, assembly, housings, _ = planting_solids
-    by_body = {"carrier1": housings[0], "gearbox2": housings[1]}
+    from helpers import gears_in_their_housings
+
     checked = 0
-    for part in assembly.parts:
-        if part.kind != "gear":
-            continue
-        housing = by_body[part.body]
-        placed = part.solid.transform(part.local(phi)[:3, :])
+    for part, _, housing, local in gears_in_their_housings(assembly, housings, phi):
+        placed = part.solid.transform(local[:3, :])
         enclosed, outside = split_encloses(housing, placed)
         assert enclosed, (part.name, outside)
         assert (placed ^ housing.base).is_empty() and (placed ^ housing.cover).is_empty()
         checked += 1
-    assert checked == 8
+    assert checked == 16

@@ -77,7 +77,8 @@ def planting_hints(mechanism, teeth: int, cutting) -> TrainHints:
     try:
         from cadgen.gears.circular import holding_set_module
 
-        module_i = holding_set_module(mechanism, cutting.circular_module)
+        module_i = holding_set_module(mechanism, cutting.circular_module,
+                                      cutting.pressure_angle_rad)
         modules.update({name: ModuleSetting("gears.circular_module", module_i)
                         for name in ("sun I", "idler 1-I", "idler 2-I", "planet I")})
     except DesignError:   # the teeth stage says why set I cannot be cut

@@ -6,10 +6,14 @@ metrics-only build, which must not pay for the cutter envelopes.
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 from kinematics.errors import DesignError
 
 __all__ = ["MIN_CIRCULAR_TEETH", "circular_module", "planting_circular_radii", "planting_modules",
-           "TRAIN1_SETS", "train1_set_radii", "holding_set_module"]
+           "TRAIN1_SETS", "train1_set_radii", "holding_set_module", "holding_set_design",
+           "SetDesign", "working_shift_sum", "planting_drive", "TrainAxes"]
 
 #: Circular gears get at least this many teeth: a standard rack undercuts fewer (2/sin^2(20 deg)).
 MIN_CIRCULAR_TEETH = 17
@@ -113,6 +117,18 @@ TRAIN1_SETS = (
 )
 
 
+@dataclass(frozen=True)
+class TrainAxes:
+    """Train 1's axes alone (``R``, ``i12``, ``i13``, ``n``, and gearbox 2's ``r``): what the sets'
+    radii and modules need, without a whole mechanism (the optimiser's rows)."""
+
+    R: float
+    i12: float
+    i13: float
+    n: float
+    r: float = 0.0
+
+
 def train1_set_radii(mechanism, key: str = "II") -> list:
     """Pitch radii (mm) of one of train 1's sets: sun (O), idler (A), idler (B), planet (C).
 
@@ -140,7 +156,199 @@ def planting_circular_radii(mechanism) -> list:
     return train1_set_radii(mechanism, "II") + [mechanism.r]
 
 
-def holding_set_module(mechanism, requested=None) -> float:
+@dataclass(frozen=True)
+class SetDesign:
+    """One of train 1's sets as cut: module, teeth, profile shifts and radii (mm).
+
+    ``reference_radii`` are ``m z / 2`` (the circles the rack cuts on), ``working_radii``
+    the circles that roll at the axis distances (``a_w z / (z1 + z2)`` of each mesh; a gear
+    in two meshes has one per mesh, the sun's and the planet's are their one mesh's). With
+    ``shifted`` False the gears are standard (``x = 0``) and both radii agree."""
+
+    module: float
+    teeth: tuple
+    shifts: tuple
+    reference_radii: tuple
+    axis_distances: tuple
+    shifted: bool
+    rule: str = ""
+    pressure_angle: float = math.radians(20.0)
+
+    @property
+    def shortening(self) -> tuple:
+        """Each gear's tip shortening, modules (:func:`tip_shortening`; 0 for standard gears)."""
+        if not self.shifted:
+            return (0.0,) * len(self.teeth)
+        return tip_shortening(self.teeth, self.module, self.shifts, self.axis_distances,
+                              self.pressure_angle)
+
+    def working_radii(self, mesh: int) -> tuple:
+        """The (drive, driven) rolling radii of mesh ``mesh`` (0, 1, 2) at its axis distance."""
+        z1, z2 = self.teeth[mesh], self.teeth[mesh + 1]
+        a = self.axis_distances[mesh]
+        return a * z1 / (z1 + z2), a * z2 / (z1 + z2)
+
+
+def _involute(alpha: float) -> float:
+    return math.tan(alpha) - alpha
+
+
+def working_shift_sum(z1: int, z2: int, module: float, axis_distance: float,
+                      pressure_angle: float) -> float:
+    """``x1 + x2`` that makes two standard-rack gears of ``z1``, ``z2`` teeth mesh without
+    backlash at ``axis_distance`` (ISO 21771): ``cos alpha_w = a cos alpha / a_w``,
+    ``x1 + x2 = (z1 + z2) (inv alpha_w - inv alpha) / (2 tan alpha)``, ``a = m (z1 + z2) / 2``."""
+    a = module * (z1 + z2) / 2
+    cosine = a * math.cos(pressure_angle) / axis_distance
+    if not 0.0 < cosine < 1.0:
+        raise ValueError(f"no working pressure angle: a = {a:g} mm at a_w = {axis_distance:g} mm")
+    alpha_w = math.acos(cosine)
+    return (z1 + z2) * (_involute(alpha_w) - _involute(pressure_angle)) / (2 * math.tan(pressure_angle))
+
+
+def _undercut_free(z: int, pressure_angle: float) -> float:
+    """The least shift that keeps a rack from undercutting ``z`` teeth: ``1 - z sin^2 alpha / 2``."""
+    return 1.0 - z * math.sin(pressure_angle) ** 2 / 2
+
+
+def _shifted_set(radii, distances, q_fraction, module, pressure_angle):
+    """Teeth and shifts of a set at ``module``: the sun's and planet's counts in the exact ratio
+    ``q_fraction`` nearest their radii, the idlers' nearest theirs, the three shift sums from
+    the axis distances, and of the one free choice left (the sun's shift; the others follow
+    along the chain) the one that keeps every gear clear of undercut by the most, then the
+    smallest largest shift. ``(worst |x|, undercut margin, teeth, shifts)`` or None when a
+    count is below ``MIN_CIRCULAR_TEETH``."""
+    p, q = q_fraction.numerator, q_fraction.denominator   # r_s / r_p = p / q
+    k = max(1, round(2 * radii[0] / module / p))
+    best = None
+    for k in (k - 1, k, k + 1):   # the sun and planet counts k p, k q nearest their radii
+        if k < 1:
+            continue
+        teeth = (k * p, round(2 * radii[1] / module), round(2 * radii[2] / module), k * q)
+        if min(teeth) < MIN_CIRCULAR_TEETH:
+            continue
+        try:
+            sums = [working_shift_sum(teeth[i], teeth[i + 1], module, distances[i],
+                                      pressure_angle) for i in range(3)]
+        except ValueError:
+            continue
+        floor = [_undercut_free(z, pressure_angle) for z in teeth]
+        # x = (x_s, S1 - x_s, S2 - S1 + x_s, S3 - S2 + S1 - x_s): each a_i + s_i x_s
+        signs = (1.0, -1.0, 1.0, -1.0)
+        offsets = (0.0, sums[0], sums[1] - sums[0], sums[2] - sums[1] + sums[0])
+        x_s, margin = _best_free_shift(offsets, signs, floor)
+        shifts = tuple(o + g * x_s for o, g in zip(offsets, signs))
+        worst = max(abs(x) for x in shifts)
+        score = (min(margin, 0.0), -worst)
+        if best is None or score > best[0]:
+            best = (score, worst, margin, teeth, shifts)
+    return None if best is None else best[1:]
+
+
+def _best_free_shift(offsets, signs, floor) -> tuple:
+    """The free shift ``x`` of a chain whose shifts are ``a_i + s_i x`` (``s_i`` = +-1): the
+    one keeping every ``x_i`` above its undercut floor ``f_i`` by the most when that margin
+    is negative; else, of those keeping all above, the one with the smallest largest ``|x_i|``.
+    Both are piecewise linear in ``x``: the best lies at a breakpoint, all of which are tried.
+    Returns ``(x, margin)``."""
+    up = min(a - f for a, s, f in zip(offsets, signs, floor) if s > 0)     # margin: up + x
+    down = min(a - f for a, s, f in zip(offsets, signs, floor) if s < 0)   # ... and down - x
+    if up + down < 0.0:   # no x clears every floor: the largest margin
+        x = (down - up) / 2
+        return x, (up + down) / 2
+    low, high = -up, down
+    candidates = {low, high}
+    lines = list(zip(offsets, signs))
+    for i, (a, s) in enumerate(lines):
+        candidates.add(-a / s)
+        for b, t in lines[i + 1:]:
+            if s != t:
+                candidates.add((b - a) / (s - t))
+            candidates.add(-(a + b) / (s + t) if s + t else low)
+    inside = [x for x in candidates if low - 1e-12 <= x <= high + 1e-12]
+    x = min(inside, key=lambda x: max(abs(a + s * x) for a, s in lines))
+    return x, min(up + x, down - x)
+
+
+def tip_shortening(teeth, module: float, shifts, distances, pressure_angle: float) -> tuple:
+    """Each gear's addendum reduction (modules) so every mesh keeps the standard tip clearance
+    at its working centre distance: ``k = (x1 + x2) - (a_w - a) / m`` per mesh (ISO 21771),
+    a gear in two meshes the larger of its two."""
+    k = [0.0] * len(teeth)
+    for i in range(len(teeth) - 1):
+        a = module * (teeth[i] + teeth[i + 1]) / 2
+        mesh = shifts[i] + shifts[i + 1] - (distances[i] - a) / module
+        k[i], k[i + 1] = max(k[i], mesh), max(k[i + 1], mesh)
+    return tuple(max(value, 0.0) for value in k)
+
+
+#: The largest profile shift (magnitude) a computed set uses: well inside the
+#: ``gears.profile_shift`` range (-0.5, 0.8) and clear of pointed tips on 17+ teeth.
+SHIFT_LIMIT = 0.5
+
+
+def holding_set_design(mechanism, requested=None, pressure_angle: float = math.radians(20.0)):
+    """Train 1's set I as cut (:class:`SetDesign`).
+
+    Standard gears when a module gives each gear whole teeth on its radius
+    (:func:`_standard_holding_module`'s rule). Otherwise profile-shifted gears: for each module
+    (``requested``, else 0.05-mm steps from 5 mm down), the teeth nearest the radii with the
+    sun-to-planet ratio exact, and the shifts that make each mesh's working centre distance
+    its axis distance; the largest module whose shifts all stay within ``SHIFT_LIMIT``. The
+    ratio must be rational (``n`` a ratio of small whole numbers); otherwise, or when no
+    module works, ``DesignError`` names the reason and the nearest base radii that need none.
+    """
+    from fractions import Fraction
+
+    radii = train1_set_radii(mechanism, "I")
+    distances = (radii[0] + radii[1], radii[1] + radii[2], radii[2] + radii[3])
+    try:
+        module = _standard_holding_module(mechanism, requested)
+    except DesignError as error:
+        if min(radii) <= 0.0:
+            raise
+        refusal = error
+    else:
+        teeth = tuple(int(round(2 * r / module)) for r in radii)
+        return SetDesign(module, teeth, (0.0,) * 4, tuple(module * z / 2 for z in teeth),
+                         distances, False, "standard gears: whole teeth at the axis distances")
+    ratio = Fraction(1.0 / (mechanism.n - 1.0)).limit_denominator(50)
+    if abs(float(ratio) - 1.0 / (mechanism.n - 1.0)) > 1e-12:
+        raise DesignError.single(
+            "train.n", "holding_set_ratio_irrational",
+            f"train 1's set I must turn its planet at exactly -1/(n - 1) = "
+            f"{-1.0 / (mechanism.n - 1.0):.6g} of the sun (relative to the carrier) to hold the "
+            f"central gear still; no whole tooth counts up to 50 give it: choose n a ratio of "
+            f"small whole numbers (3, 2.5, 4, ...). {refusal.problems[0].message}")
+    modules = ([float(requested)] if requested is not None
+               else [round(step * 0.05, 10) for step in range(100, 9, -1)])
+    chosen = None
+    for module in modules:   # the largest module clear of undercut, else the one nearest it
+        found = _shifted_set(radii, distances, ratio, module, pressure_angle)
+        if found is None or found[0] > SHIFT_LIMIT:
+            continue
+        if chosen is None or (chosen[1][1] < 0.0 and found[1] > chosen[1][1]):
+            chosen = (module, found)
+        if found[1] >= 0.0:
+            break
+    if chosen is not None:
+        module, (_, _, teeth, shifts) = chosen
+        return SetDesign(module, tuple(int(z) for z in teeth), tuple(shifts),
+                         tuple(module * z / 2 for z in teeth), distances, True,
+                         "profile-shifted gears: whole teeth nearest the radii, the "
+                         "sun-to-planet ratio exact, each mesh's shift sum from its axis distance "
+                         "(ISO 21771), the free choice keeping every gear clear of undercut, "
+                         "tips shortened to the standard clearance", pressure_angle)
+    raise refusal
+
+
+def holding_set_module(mechanism, requested=None,
+                       pressure_angle: float = math.radians(20.0)) -> float:
+    """The module of train 1's set I (:func:`holding_set_design`), mm."""
+    return holding_set_design(mechanism, requested, pressure_angle).module
+
+
+def _standard_holding_module(mechanism, requested=None) -> float:
     """The module of train 1's set I (its planet holds the central gear still), mm.
 
     ``requested`` (the file's ``gears.circular_module``) when it gives the set whole tooth
@@ -192,14 +400,15 @@ def planting_modules(mechanism, teeth: int, requested=None) -> tuple:
 DRIVE_SLEEVE_DIAMETER = 40.0
 
 
-def planting_drive(mechanism, module_c: float, requested=None, carrier_rpm: float = 30.0):
+def planting_drive(mechanism, module_c: float, requested=None, carrier_rpm: float = 30.0,
+                   pressure_angle: float = math.radians(20.0)):
     """The frame's drive of a planting design: :func:`cadgen.gears.drive.drive_design` at n with
     the larger of train 1's two modules (``module_c`` set II's, as :func:`planting_modules`
     gives it; ``requested`` the file's ``gears.circular_module``)."""
     from cadgen.gears.drive import drive_design
 
     try:
-        module_i = holding_set_module(mechanism, requested)
+        module_i = holding_set_module(mechanism, requested, pressure_angle)
     except DesignError:
         module_i = module_c
     return drive_design(mechanism.n, carrier_rpm, max(module_c, module_i), DRIVE_SLEEVE_DIAMETER)

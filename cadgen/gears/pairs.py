@@ -413,7 +413,8 @@ def generate_gear(name, curve: ArcLengthCurve, teeth: int, system: ToothSystem, 
 def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
                   system: ToothSystem | None = None, force_shaper: bool = False,
                   bore_radius: float = 0.0, flank_points: int = 48, drive_phase=None,
-                  drive_gear=None, symmetric: bool = True, shifts=None) -> GeneratedPair:
+                  drive_gear=None, symmetric: bool = True, shifts=None,
+                  shortening=(0.0, 0.0)) -> GeneratedPair:
     """Tooth both gears of a pair, phased to assemble at ``tau = 0``, with their checks.
 
     ``teeth`` is one count or (drive, driven). The module follows from the
@@ -424,9 +425,10 @@ def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
     :func:`generate_gear`).
 
     ``shifts`` (drive, driven) are the gears' profile-shift coefficients; by default the
-    system's for the drive and its opposite for the driven gear. They must sum to zero
-    (V-zero): the pitch curves and the centre distance stay as they are, and so do the
-    phases (tooth centres do not move).
+    system's for the drive and its opposite for the driven gear. A non-circular pair's must
+    sum to zero (V-zero): the pitch curves and the centre distance stay as they are, and so
+    do the phases (tooth centres do not move). A circular pair's may not (a V pair, cut on
+    its reference circles; the caller meshes it at its working centre distance).
     """
     teeth = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
     curves = (pair.curve(0), pair.curve(1))
@@ -435,10 +437,15 @@ def generate_pair(pair: PitchPair, teeth, *, module: float | None = None,
     if shifts is None:
         shifts = (system.profile_shift, -system.profile_shift)
     shifts = tuple(float(x) for x in shifts)
-    if len(shifts) != 2 or not abs(shifts[0] + shifts[1]) <= 1e-12:
+    # V-zero keeps a non-circular pair's pitch curves; circular gears may take any two shifts
+    # (a V pair: they mesh at another centre distance, :func:`cadgen.gears.circular.
+    # working_shift_sum`), cut on their reference circles, tooth centres where they were
+    if len(shifts) != 2 or (not pair.radii and not abs(shifts[0] + shifts[1]) <= 1e-12):
         raise ValueError(f"the profile shifts of a pair must sum to zero (V-zero), not {shifts}")
-    systems = tuple(dataclasses.replace(system, profile_shift=x)
-                    if x != system.profile_shift else system for x in shifts)
+    # ``shortening`` (modules, each gear's): tips cut lower so a V pair keeps its clearance
+    systems = tuple(dataclasses.replace(system, profile_shift=x, addendum=system.addendum - k)
+                    if (x != system.profile_shift or k) else system
+                    for x, k in zip(shifts, shortening))
     if drive_phase is None:  # a tooth centred on the start contact
         drive_phase = float(curves[0].arc_of_source(np.array([0.0]))[0])
     elif drive_gear is not None:

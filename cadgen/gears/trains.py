@@ -21,7 +21,7 @@ from kinematics.errors import DesignError
 from kinematics.profile_shift import shift_key
 
 from cadgen.gears.advice import advise_train, planting_hints, pricking_hints
-from cadgen.gears.circular import (TRAIN1_SETS, _radius_hint, circular_module, holding_set_module,
+from cadgen.gears.circular import (TRAIN1_SETS, _radius_hint, circular_module, holding_set_design,
                                    planting_circular_radii, planting_drive, train1_set_radii)
 from cadgen.gears.pairs import (FAILING_PROBLEMS, MIN_ROOT_THICKNESS, PitchPair, circle_pair,
                                 generate_pair)
@@ -88,10 +88,12 @@ CIRCULAR_PITCH_POSES = 32
 
 
 def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=False, cache=None,
-           shifts=(0.0, 0.0)):
+           shifts=(0.0, 0.0), working=None, shortening=(0.0, 0.0)):
     """One pair cut, checked and meshed (tip relief if needed); looked up in ``cache`` first
     (a :class:`~cadgen.gears.cache.GearCache` or None) and stored there once computed.
-    ``shifts``: the (drive, driven) profile shifts (V-zero)."""
+    ``shifts``: the (drive, driven) profile shifts (V-zero, or any two on circular gears cut
+    on ``pair``'s reference circles and meshed on ``working``, the pair of rolling circles at
+    the working centre distance)."""
     bore = cutting.bore_diameter / 2
     force_shaper = cutting.cutter == "shaper"
     counts = (teeth, teeth) if np.isscalar(teeth) else tuple(teeth)
@@ -103,17 +105,18 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
     if cache is not None:
         from cadgen.gears.cache import stage_key
 
-        key = stage_key(name, pair, teeth, system, flank_points=cutting.flank_points,
+        key = stage_key(name, working or pair, teeth, system, flank_points=cutting.flank_points,
                         bore_radius=bore, force_shaper=force_shaper, poses=poses, span=span,
-                        circular=circular, drive=drive, shifts=shifts)
+                        circular=circular, drive=drive, shifts=shifts
+                        if not any(shortening) else tuple(shifts) + tuple(shortening))
         stored = cache.get(key)
         if stored is not None:
             generated, report, relief = stored
             # the pair's contact functions are closures, never stored: the caller's, re-attached
-            return GearStage(name, dataclasses.replace(generated, pair=pair), report, placement,
-                             relief)
+            return GearStage(name, dataclasses.replace(generated, pair=working or pair), report,
+                             placement, relief)
     stage = _cut_stage(name, pair, teeth, system, bore, force_shaper, cutting.flank_points,
-                       placement, drive, poses, span, shifts)
+                       placement, drive, poses, span, shifts, working, shortening)
     if cache is not None:   # a stage that raised (DesignError) never gets here: not cached
         cache.put(key, (dataclasses.replace(stage.generated, pair=None), stage.meshing,
                         stage.relief))
@@ -121,14 +124,17 @@ def _stage(name, pair, teeth, system, cutting, placement, drive=None, circular=F
 
 
 def _cut_stage(name, pair, teeth, system, bore, force_shaper, flank_points, placement, drive,
-               poses, span, shifts=(0.0, 0.0)):
+               poses, span, shifts=(0.0, 0.0), working=None, shortening=(0.0, 0.0)):
     options = dict(system=system, bore_radius=bore, flank_points=flank_points,
-                   force_shaper=force_shaper, shifts=shifts)
+                   force_shaper=force_shaper, shifts=shifts, shortening=shortening)
     if drive is not None:
         generated = generate_pair(pair, teeth, drive_phase=drive[0], drive_gear=drive[1],
                                   **options)
     else:
         generated = generate_pair(pair, teeth, **options)
+    if working is not None:   # cut on the reference circles, meshed at the working distance
+        generated = dataclasses.replace(generated, pair=working)
+        pair = working
     report = meshing_check(generated.profiles[0], generated.profiles[1], pair, poses=poses,
                            span=span)
     relief = None
@@ -226,30 +232,39 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
     axes = [0.0] + [mechanism.carrier_radii[axis] for axis in ("A", "B", "C")]
     sets = []
     for key, set_name, _, names in TRAIN1_SETS:
+        design = None
         if key == "II":
             set_radii, set_system = radii[:4], system
         else:
-            set_module = holding_set_module(mechanism, cutting.circular_module)
-            set_radii, set_system = train1_set_radii(mechanism, "I"), _system(cutting, set_module)
+            design = holding_set_design(mechanism, cutting.circular_module,
+                                        cutting.pressure_angle_rad)
+            set_radii, set_system = design.reference_radii, _system(cutting, design.module)
         counts = [int(round(2 * x / set_system.module)) for x in set_radii]
         drive = None
         for k in range(3):
             pair = circle_pair((names[k], names[k + 1]), set_radii[k], set_radii[k + 1])
+            working, mesh_shifts, short = None, _shifts(shifts, pair), (0.0, 0.0)
+            if design is not None and design.shifted:   # V pairs at the axis distances
+                working = circle_pair(pair.names, *design.working_radii(k))
+                mesh_shifts = design.shifts[k], design.shifts[k + 1]
+                short = design.shortening[k], design.shortening[k + 1]
             stage = _stage(f"train 1 set {key}: {names[k]} to {names[k + 1]}", pair,
                            (counts[k], counts[k + 1]), set_system, cutting,
                            (carrier, axes[k] * line), drive=drive, circular=True, cache=cache,
-                           shifts=_shifts(shifts, pair))
+                           shifts=mesh_shifts, working=working, shortening=short)
             stages.append(stage)
             cut(stage.name)
             drive = _carry(stage.generated)
         ratio = (-2.0 if key == "II" else -1.0) / (mechanism.n - 1.0)
         sets.append({"key": key, "name": set_name, "converted_ratio": ratio,
+                     "rule": design.rule if design is not None else
+                     "standard gears: whole teeth at the axis distances",
                      "axes": ("O", "A", "B", "C"), "axis_distances": tuple(
                          float(axes[k + 1] - axes[k]) for k in range(3)),
                      "stages": tuple(s.name for s in stages[-3:])})
     # the frame's drive: the input shaft turns the central shaft and carrier 1 the same way
     drive = planting_drive(mechanism, module, cutting.circular_module,
-                           params.field.carrier_speed_rpm)
+                           params.field.carrier_speed_rpm, cutting.pressure_angle_rad)
     drive_system = _system(cutting, drive.module_1)
     origin = np.array([-drive.centre_distance, 0.0])
     for k, names in enumerate((("input gear 1", "central shaft gear"),
@@ -356,20 +371,43 @@ def train_report(train: GearTrain) -> dict:
     return out
 
 
+def working_centre_distance(z1: int, z2: int, module: float, shift_sum: float,
+                            pressure_angle: float) -> float:
+    """The centre distance (mm) two standard-rack gears with profile shifts summing to
+    ``shift_sum`` mesh at without backlash: ``inv alpha_w = inv alpha + 2 tan alpha (x1 + x2) /
+    (z1 + z2)`` solved for ``alpha_w`` by Newton's method, ``a_w = m (z1 + z2) / 2 cos alpha /
+    cos alpha_w`` (ISO 21771); ``m (z1 + z2) / 2`` for standard gears."""
+    a = module * (z1 + z2) / 2
+    if shift_sum == 0.0:
+        return a
+    target = math.tan(pressure_angle) - pressure_angle + 2 * math.tan(pressure_angle) * \
+        shift_sum / (z1 + z2)
+    alpha = pressure_angle
+    for _ in range(50):   # inv'(alpha) = tan^2 alpha
+        step = (math.tan(alpha) - alpha - target) / math.tan(alpha) ** 2
+        alpha -= step
+        if abs(step) < 1e-15:
+            break
+    return a * math.cos(pressure_angle) / math.cos(alpha)
+
+
 def set_report(train: GearTrain, record: dict) -> dict:
     """One of train 1's sets: its converted ratio (from the cut teeth: three external meshes,
     ``-z_sun / z_planet``) against the one asked for, and each mesh's working centre distance
-    (standard gears: ``m (z1 + z2) / 2``, from the cut gears' modules and teeth, not from the
-    radii they were cut for) against the axis distance on the carrier."""
+    (:func:`working_centre_distance` of the cut gears' teeth, module and profile shifts, not
+    the radii they were cut for) against the axis distance on the carrier."""
     by_name = {s.name: s for s in train.stages}
     meshes = []
     for name, axis_distance in zip(record["stages"], record["axis_distances"]):
         stage = by_name[name]
         drive, driven = stage.generated.profiles
-        working = 0.5 * (drive.module * drive.teeth + driven.module * driven.teeth)
+        x1, x2 = (float(check.profile_shift) for check in stage.generated.checks)
+        working = working_centre_distance(drive.teeth, driven.teeth, float(drive.module),
+                                          x1 + x2, stage.generated.system.pressure_angle)
         meshes.append({"driver": drive.name, "driven": driven.name,
                        "driver_teeth": int(drive.teeth), "driven_teeth": int(driven.teeth),
                        "module_mm": float(drive.module),
+                       "profile_shifts": [x1, x2],
                        "centre_distance_mm": float(working),
                        "axis_distance_mm": float(axis_distance),
                        "centre_distance_error_mm": float(working - axis_distance)})
@@ -378,7 +416,7 @@ def set_report(train: GearTrain, record: dict) -> dict:
             "converted_ratio": float(record["converted_ratio"]),
             "converted_ratio_teeth": float(achieved),
             "ratio_exact": abs(achieved - record["converted_ratio"]) <= 1e-12,
-            "axes": list(record["axes"]), "meshes": meshes}
+            "rule": record.get("rule", ""), "axes": list(record["axes"]), "meshes": meshes}
 
 
 #: The undercut policy in words, for the report (the threshold is ``MIN_ROOT_THICKNESS``).

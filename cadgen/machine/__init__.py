@@ -15,6 +15,8 @@ fits
     allowances, backlash and materials (:func:`process_fits`).
 loads
     The torque chain from the tool's tip load to every gear, and the shafts' speeds.
+layouts
+    Where each axis is and what it carries, each housing's cavity, the housings' stack.
 shafts
     The beam on two bearings, the diameter from torque and bending, keys and D-flats.
 bearings

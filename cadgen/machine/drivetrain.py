@@ -7,12 +7,14 @@ for both mechanism kinds, numbers only; the solids are built from its records
 (:mod:`cadgen.machine.model`). Failing checks are collected as
 :class:`kinematics.errors.Problem` items, never raised, so a report lists them all.
 
-Layouts follow the solids (:mod:`cadgen.solids.planting`, :mod:`cadgen.solids.pricking`):
-gearbox 1 has one gear layer at ``z = gap`` (cavity ``face_c + 2 gap``); gearbox 2
-the non-circular pair at ``gap`` and the 1:1 pair at ``2 gap + face_nc`` (cavity
-``face_nc + face_c + 3 gap``); the pricking case stage 1 at ``gap`` and stage 2 at
-``2 gap + face_1`` (cavity ``face_1 + face_2 + 3 gap``). The end walls must hold
-the bearings, whose widths depend on the loads, whose heights depend on the walls:
+Layouts (:mod:`cadgen.machine.layouts`) follow the solids (:mod:`cadgen.solids.planting`,
+:mod:`cadgen.solids.pricking`): gearbox 1 has two gear layers (train 1's set I at ``gap``,
+set II at ``2 gap + face_I``), gearbox 2 the non-circular pair and the 1:1 pair, the frame
+the drive's two pairs; the pricking case stage 1 and stage 2. A shaft may reach into another
+housing (O from the frame's floor to gearbox 1's roof, C2 from gearbox 1's floor to gearbox
+2's roof) or be hollow and carry the next housing on a bolted flange, in a pair of bearings
+in its housing's roof (the sleeve S carries gearbox 1, C carries gearbox 2). The end walls
+must hold the bearings, whose widths depend on the loads, whose heights depend on the walls:
 the sizing is repeated until bearings and walls no longer change.
 """
 
@@ -23,11 +25,12 @@ from dataclasses import dataclass
 
 from kinematics.errors import Problem
 
-from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, planting_modules
+from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER
 from cadgen.machine.bearings import select_bearing
 from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
 from cadgen.machine.fits import process_fits
-from cadgen.machine.loads import planting_loads, pricking_loads
+from cadgen.machine.layouts import (HOLLOW_WALL_MIN, _mount_fields, carry_flange, planting_axes,
+                                    pricking_axes)
 from cadgen.machine.model import BearingSeat, Drivetrain, GearMount, HousingStack, Shaft
 from cadgen.machine.shafts import (RULES as SHAFT_RULES, beam_reactions, choose_diameter,
                                    hub_key, key_pressure, max_bending, required_diameter,
@@ -38,9 +41,6 @@ __all__ = ["drivetrain", "drivetrain_report", "RULES", "MAX_ITERATIONS"]
 #: Rounds of bearing choice and wall sizing before giving up on a fixed point (each round can
 #: only pick the next bearing series, so a handful suffices).
 MAX_ITERATIONS = 8
-#: A drive shaft's stub below the floor: twice its diameter for a coupling's hub, plus 20 mm to
-#: reach past the frame plate it is fixed to.
-STUB_DIAMETERS, STUB_EXTRA = 2.0, 20.0
 #: The shoulder a seat needs behind its bearing: at least 2 mm, or half the side wall.
 SHOULDER_MIN, SHOULDER_RATIO = 2.0, 0.5
 
@@ -58,41 +58,6 @@ RULES = {
 
 
 @dataclass(frozen=True)
-class _Axis:
-    """An axis to size: where it is, what it carries, where it leaves its housing.
-
-    ``mounts``: ``(gear, z_bottom, face_width)`` in the axis's housing, or ``(gear, z_bottom,
-    face_width, housing, free)`` for a gear turning in another housing's cavity (``z_bottom``
-    from that one's floor) or running ``free`` on the shaft on its own bearings.
-    """
-
-    name: str
-    housing: str
-    side: int
-    xy: tuple
-    loads: object                 # loads.AxisLoads
-    mounts: tuple
-    floor_through: bool
-    roof_through: bool
-    below: object                 # d -> mm beyond the floor's outer face
-    above: float
-    external_above: object        # (walls, bases) -> z of the external load (the stack's frame)
-    note: str = ""
-    roof_housing: str | None = None   # the upper bearing's housing (None: the axis's own)
-    roof_pair: bool = False       # hollow: both bearings side by side in the housing's roof
-    inside: str | None = None     # hollow: the axis that turns inside it
-    carries: str | None = None    # hollow: the housing its flange is bolted to
-
-
-@dataclass(frozen=True)
-class _Cavity:
-    side_wall: float
-    height: float
-    parting_z: float
-    layers: tuple
-
-
-@dataclass(frozen=True)
 class _Sized:
     diameter: float
     required: float
@@ -103,15 +68,6 @@ class _Sized:
     bore: float = 0.0             # a hollow shaft's bore
 
 
-def _mount_fields(mount) -> tuple:
-    """``(gear, z_bottom, face, housing or None, free)`` of an axis's mount tuple."""
-    gear, z, face = mount[:3]
-    housing = mount[3] if len(mount) > 3 else None
-    free = bool(mount[4]) if len(mount) > 4 else False
-    return gear, z, face, housing, free
-
-
-# ------------------------------------------------------------------ layouts
 def _cam_bore_problems(params, shafts) -> list:
     """A cam bore given in the file that the E shaft does not turn freely in (planting).
 
@@ -128,175 +84,6 @@ def _cam_bore_problems(params, shafts) -> list:
                     f"the cam's bore of {given:g} mm is smaller than the {hole:g} mm the E shaft "
                     "turns in (its diameter plus the running clearance): leave cam.bore_diameter "
                     "out, or give at least that")]
-
-
-#: The flange a hollow shaft carries a housing with (ISO 4762 screws into tapped holes of the
-#: housing's floor): its bolt, the number of bolts, its thickness in bolt diameters, and the
-#: flange's radius beyond the bolt circle, in bolt diameters.
-CARRY_BOLT, CARRY_BOLTS, CARRY_FLANGE_THICKNESS, CARRY_FLANGE_MARGIN = "M6", 6, 1.5, 1.25
-#: Least wall (mm) of a hollow shaft round its bore, under the keyseat.
-HOLLOW_WALL_MIN = 2.0
-
-
-def carry_flange(outside: float) -> dict:
-    """The bolted flange on a hollow shaft of ``outside`` diameter that carries a housing:
-    ``CARRY_BOLTS`` screws of ``CARRY_BOLT`` on a circle 1.5 bolt diameters outside the shaft."""
-    bolt = float(CARRY_BOLT.removeprefix("M"))
-    circle = outside / 2 + 1.5 * bolt
-    return {"bolt": CARRY_BOLT, "bolts": CARRY_BOLTS, "bolt_circle_radius": circle,
-            "radius": circle + CARRY_FLANGE_MARGIN * bolt + bolt / 2,
-            "thickness": CARRY_FLANGE_THICKNESS * bolt}
-
-
-def planting_bases(cavities, gap: float):
-    """``walls -> {housing: z of its cavity floor}`` in gearbox 1's frame: the frame (the
-    transmission box) below gearbox 1, the flange of the sleeve that carries gearbox 1 between
-    them; gearbox 2 above, the flange of the hollow shaft C that carries it between them."""
-    flange = carry_flange(0.0)["thickness"]
-
-    def bases(walls):
-        out = {"gearbox1": 0.0}
-        h1 = cavities["gearbox1"].height
-        out["gearbox2"] = h1 + walls["gearbox1"][1] + gap + flange + gap + walls["gearbox2"][0]
-        if "frame" in cavities:
-            out["frame"] = -(walls["gearbox1"][0] + gap + flange + gap + walls["frame"][1]
-                             + cavities["frame"].height)
-        return out
-    return bases
-
-
-def _planting_axes(params, mechanism) -> tuple:
-    from cadgen.gears.circular import holding_set_module, planting_drive
-    from kinematics.errors import DesignError
-
-    housing, gears = params.housing, params.gears
-    gap = housing.axial_gap
-    module_nc, module_c = planting_modules(mechanism, params.pitch_curve.teeth,
-                                           gears.circular_module)
-    try:
-        module_i = holding_set_module(mechanism, gears.circular_module)
-    except DesignError:   # the teeth stage refuses the set and says why; size as set II's
-        module_i = module_c
-    face_nc, face_c = gears.face_width_for(module_nc), gears.face_width_for(module_c)
-    face_i = gears.face_width_for(module_i)
-    drive = planting_drive(mechanism, module_c, gears.circular_module,
-                           params.field.carrier_speed_rpm)
-    face_d = gears.face_width_for(drive.module_1)
-    # gearbox 1: set I (it holds the central gear) below, set II (it carries gearbox 2) above:
-    # the planet of set II is on the hollow shaft C, set I's on the shaft C2 inside it
-    box1 = face_i + face_c + 3 * gap
-    layer1_2 = 2 * gap + face_i
-    box2 = face_nc + face_c + 3 * gap
-    layer2 = 2 * gap + face_nc
-    frame_height = 2 * face_d + 3 * gap
-    cavities = {
-        "gearbox1": _Cavity(housing.wall_for(max(module_c, module_i)), box1, box1,
-                            ((gap, face_i), (layer1_2, face_c))),
-        "gearbox2": _Cavity(housing.wall_for(max(module_nc, module_c)), box2,
-                            gap + face_nc + gap / 2, ((gap, face_nc), (layer2, face_c))),
-        "frame": _Cavity(housing.wall_for(drive.module_1), frame_height, frame_height,
-                         ((gap, face_d), (2 * gap + face_d, face_d))),
-    }
-    bases = planting_bases(cavities, gap)
-    loads = planting_loads(mechanism, params.machine, gears.pressure_angle_rad,
-                           params.field.carrier_speed_rpm, drive=drive)
-    cam, arm = params.cam.thickness, params.planter.arm_thickness
-    a, r = float(mechanism.centre_distance), float(mechanism.r)
-    line = (math.cos(mechanism.phi0), math.sin(mechanism.phi0))
-    radii = mechanism.carrier_radii
-
-    def planter_plane(walls, base):   # the planter plate's mid-plane above gearbox 2's roof
-        return (base["gearbox2"] + box2 + walls["gearbox2"][1]) + gap + cam + gap + arm / 2
-
-    stub = lambda d: STUB_DIAMETERS * d + STUB_EXTRA   # noqa: E731
-    none = lambda d: 0.0   # noqa: E731
-    frame_layers = (gap, 2 * gap + face_d)
-    input_xy = (-drive.centre_distance, 0.0)
-    axes = [
-        # the central shaft: in the frame's floor and gearbox 1's roof; its gear in the frame,
-        # both suns in gearbox 1; it turns inside the sleeve that carries gearbox 1
-        _Axis("O", "frame", 1, (0.0, 0.0), loads["O"],
-              (("central shaft gear", frame_layers[0], face_d),
-               ("sun I", gap, face_i, "gearbox1", False),
-               ("sun", layer1_2, face_c, "gearbox1", False)),
-              False, False, none, 0.0, None, "the central shaft: both suns, driven in the frame",
-              roof_housing="gearbox1"),
-        # the sleeve: bolted to gearbox 1's floor, the transmission driven gear keyed on it,
-        # in a pair of bearings in the frame's roof
-        _Axis("S", "frame", 1, (0.0, 0.0), loads["S"],
-              (("transmission driven gear", frame_layers[1], face_d),),
-              False, True, none, 0.0, planter_plane,
-              "the sleeve: carries gearbox 1 (carrier 1), turned by the transmission driven gear",
-              roof_pair=True, inside="O", carries="gearbox1"),
-        _Axis("input", "frame", 1, input_xy, loads["input"],
-              (("input gear 1", frame_layers[0], face_d),
-               ("input gear 2", frame_layers[1], face_d)),
-              True, False, stub, 0.0, None,
-              "the input: a keyed end below the frame for a sprocket or coupling"),
-    ]
-    for side, sign in ((1, 1.0), (2, -1.0)):
-        xy = {axis: (sign * radii[axis] * line[0], sign * radii[axis] * line[1])
-              for axis in ("A", "B", "C")}
-        for axis, keyed, free in (("A", "idler 1", "idler 1-I"), ("B", "idler 2", "idler 2-I")):
-            axes.append(_Axis(axis, "gearbox1", side, xy[axis], loads[axis],
-                              ((free, gap, face_i, None, True), (keyed, layer1_2, face_c)),
-                              False, False, none, 0.0, None,
-                              f"{keyed} keyed; {free} (set I) runs free on two bearings"))
-        axes.append(_Axis("C2", "gearbox1", side, xy["C"], loads["C2"],
-                          (("planet I", gap, face_i),
-                           ("central", gap, face_nc, "gearbox2", False)),
-                          False, False, none, 0.0, None,
-                          "inner shaft: planet I (set I, it does not turn) holds the central gear "
-                          "in gearbox 2 through the hollow shaft C", roof_housing="gearbox2"))
-        axes.append(_Axis("C", "gearbox1", side, xy["C"], loads["C"],
-                          (("train-1 planet", layer1_2, face_c),),
-                          False, True, none, 0.0, planter_plane,
-                          "hollow shaft: planet of set II; its flange carries gearbox 2",
-                          roof_pair=True, inside="C2", carries="gearbox2"))
-    axes += [
-        _Axis("D", "gearbox2", 1, (a, 0.0), loads["D"],
-              (("intermediate", gap, face_nc), ("gear D", layer2, face_c)),
-              False, False, none, 0.0, None),
-        _Axis("E", "gearbox2", 1, (a + 2 * r, 0.0), loads["E"],
-              (("planet gear E", layer2, face_c),), False, True, none,
-              gap + cam + gap + arm, planter_plane,
-              "carries the planter; the cam, fixed to gearbox 2, is bored clear of it"),
-    ]
-    return axes, cavities, loads, bases, drive
-
-
-def _pricking_axes(params, design) -> tuple:
-    housing, gears = params.housing, params.gears
-    gap = housing.axial_gap
-    faces = [gears.face_width_for(m) for m in design.modules]
-    cavity = faces[0] + faces[1] + 3 * gap
-    layer2 = 2 * gap + faces[0]
-    cavities = {"gear-case": _Cavity(housing.wall_for(max(design.modules)), cavity,
-                                     gap + faces[0] + gap / 2,
-                                     ((gap, faces[0]), (layer2, faces[1])))}
-    loads = pricking_loads(design, params.machine, gears.pressure_angle_rad,
-                           params.field.carrier_speed_rpm)
-    link = design.linkage
-    start = design.motion.phi1_start
-    centre = [float(v) for v in link.centre]
-
-    def at(distance):
-        return (centre[0] + distance * math.cos(start), centre[1] + distance * math.sin(start))
-
-    rocker = params.linkage.rocker_thickness
-    axes = [
-        _Axis("sun", "gear-case", 1, at(0.0), loads["sun"], (("sun", gap, faces[0]),),
-              True, False, lambda d: STUB_DIAMETERS * d + STUB_EXTRA, 0.0, None,
-              "fixed to the frame: the case turns about it"),
-        _Axis("intermediate", "gear-case", 1, at(link.a), loads["intermediate"],
-              (("intermediate 1", gap, faces[0]), ("intermediate 2", layer2, faces[1])),
-              False, False, lambda d: 0.0, 0.0, None),
-        _Axis("planet", "gear-case", 1, at(2 * link.a), loads["planet"],
-              (("planet", layer2, faces[1]),), False, True, lambda d: 0.0, gap + rocker,
-              lambda walls, base: cavity + walls["gear-case"][1] + gap + rocker / 2,
-              "carries the rocker and the needle"),
-    ]
-    return axes, cavities, loads, (lambda walls: {"gear-case": 0.0}), None
 
 
 # ------------------------------------------------------------------ sizing
@@ -357,8 +144,11 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
     if axis.inside is not None and inner is not None:
         bore = inner.diameter + clearance
         required = _hollow_required(bending, axis.loads.torque_nmm, bore, machine)
+        # the smallest bearing bore whose tube (under its keyseat) is strong enough and whose
+        # keys carry the torque within key_pressure_mpa: a hollow shaft carries a housing's
         fits_tube = [b for b in preferred_diameters()
-                     if _core(b) >= required - 1e-9 and _core(b) - bore >= 2 * HOLLOW_WALL_MIN]
+                     if _core(b) >= required - 1e-9 and _core(b) - bore >= 2 * HOLLOW_WALL_MIN
+                     and _keys_hold(axis, b, machine)]
         d = float(given) if given is not None else (fits_tube[0] if fits_tube
                                                      else preferred_diameters()[-1])
     else:
@@ -366,8 +156,10 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
                                      machine.shaft_safety_factor)
         if given is not None:
             d = float(given)
-        else:
-            d = choose_diameter(required) or preferred_diameters()[-1]
+        else:   # the smallest bearing bore strong enough whose keys carry their torques
+            strong = choose_diameter(required) or preferred_diameters()[-1]
+            d = next((b for b in preferred_diameters()
+                      if b >= strong and _keys_hold(axis, b, machine)), strong)
     reactions = tuple(abs(v) for v in beam_reactions(z1, z2, loads))
     bore_j = _journal_bore(d)
     if axis.roof_pair:   # a pair is two of one bearing: chosen for the larger reaction
@@ -386,6 +178,22 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
                                       machine.bearing_life_min_h, min_width=width)
                        for load, width in zip(reactions, widths))
     return _Sized(d, required, bending, reactions, chosen, overhang, bore)
+
+
+def _keys_hold(axis, d: float, machine) -> bool:
+    """Whether every keyed hub on the axis carries its torque on a shaft of ``d``."""
+    for mount in axis.mounts:
+        gear, _, face, _, free = _mount_fields(mount)
+        if free:
+            continue
+        try:
+            key = hub_key(d, face)
+        except CatalogueError:
+            return False
+        torque = axis.loads.gears[gear].torque_nmm
+        if key is not None and key_pressure(torque, d, key) > machine.key_pressure_mpa:
+            return False
+    return True
 
 
 def _seat_walls(axis) -> tuple:
@@ -525,6 +333,28 @@ def _flange_problems(axis, d, torque_nmm, flange) -> list:
                     f"{FLANGE_SHEAR_ALLOW:g} MPa")]
 
 
+def _coupling_key(axis, d: float, stub: float, machine, report: bool) -> tuple:
+    """The DIN 6885 key of a shaft's stub (the sprocket's or coupling's hub is the stub less a
+    chamfer each end, ``STUB_CHAMFER``), and its flank pressure under the shaft's torque."""
+    try:
+        key = hub_key(d, stub - 2 * STUB_CHAMFER)
+    except CatalogueError as error:
+        return None, ([Problem(f"machine.shafts.{axis.name}", "coupling_without_key",
+                               f"the {d:g} mm stub of shaft {axis.name} takes no key: {error}")]
+                      if report else [])
+    if key is None or not report:
+        return key, []
+    pressure = key_pressure(axis.loads.torque_nmm, d, key)
+    if pressure <= machine.key_pressure_mpa:
+        return key, []
+    return key, [Problem(f"machine.shafts.{axis.name}", "key_overloaded",
+                         f"the coupling key of shaft {axis.name} ({key.designation}) carries "
+                         f"{axis.loads.torque_nmm / 1000:.1f} N m at {pressure:.0f} MPa, above "
+                         f"machine.key_pressure_mpa = {machine.key_pressure_mpa:g} MPa")]
+
+
+#: The stub's chamfer at each end of a coupling's hub (mm): the key is no longer than the rest.
+STUB_CHAMFER = 2.0
 #: The carrying flange's screws (8.8): allowed shear stress, MPa.
 FLANGE_SHEAR_ALLOW = 190.0
 
@@ -583,9 +413,9 @@ def drivetrain(params, design) -> Drivetrain:
     machine = params.machine
     fits = process_fits(params.manufacturing.process)
     if params.mechanism == "planting":
-        axes, cavities, loads, bases, drive = _planting_axes(params, design)
+        axes, cavities, loads, bases, drive = planting_axes(params, design)
     elif params.mechanism == "pricking":
-        axes, cavities, loads, bases, drive = _pricking_axes(params, design)
+        axes, cavities, loads, bases, drive = pricking_axes(params, design)
     else:
         raise ValueError(f"no drivetrain for mechanism {params.mechanism!r}")
     given = machine.shafts.given()
@@ -640,12 +470,16 @@ def drivetrain(params, design) -> Drivetrain:
             flange["carries"] = axis.carries
             if report:
                 problems += _flange_problems(axis, d, axis.loads.torque_nmm, flange)
+        coupling = None
+        if axis.floor_through and axis.below(d) > 0:   # a stub for a sprocket or coupling
+            coupling, found = _coupling_key(axis, d, float(axis.below(d)), machine, report)
+            problems += found
         shafts.append(Shaft(axis.name, axis.housing, axis.side, axis.xy, d, size.required,
                             axis.name in given, axis.loads.torque_nmm / 1000.0, size.bending,
                             axis.loads.speed_rpm, mounts, tuple(seats),
                             float(axis.below(d)) if axis.floor_through else 0.0,
                             axis.above if axis.roof_through else 0.0, axis.note,
-                            size.bore, ends, flange))
+                            size.bore, ends, flange, coupling))
         del stack
     sleeve = next((s for s in shafts if s.name == "S"), None)
     if sleeve is not None and sleeve.diameter > DRIVE_SLEEVE_DIAMETER + 1e-9:
@@ -736,7 +570,11 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
             "speed_rpm": shaft.speed_rpm, "length_mm": _length(shaft, stack),
             "extends_below_mm": shaft.extends_below, "extends_above_mm": shaft.extends_above,
             "strength_passed": shaft.strength_passed, "note": shaft.note, "hubs": hubs,
-            "bore_mm": shaft.bore, "flange": shaft.flange})
+            "bore_mm": shaft.bore, "flange": shaft.flange,
+            "coupling_key": None if shaft.coupling_key is None else {
+                "designation": shaft.coupling_key.designation,
+                "pressure_mpa": _finite(key_pressure(shaft.torque_nm * 1000.0, shaft.diameter,
+                                                     shaft.coupling_key))}})
         for seat in shaft.seats:
             b = seat.bearing
             seats.append({

@@ -128,6 +128,7 @@ class Shaft:
     ends: tuple | None = None  # (z_bottom, z_top) from its housing's cavity floor (mm), when
     #                            it reaches into another housing; None: from its seats
     flange: dict | None = None  # a hollow shaft's bolted flange carrying a housing
+    coupling_key: KeySize | None = None   # the key of its stub (a sprocket or coupling on it)
 
     @property
     def strength_passed(self) -> bool:

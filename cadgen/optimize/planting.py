@@ -64,7 +64,8 @@ _HOUSING_PATHS = (("housing.clearance", "housing.wall")
 _REFUSED = {
     "pitch_curve.e2": "2*e2 must stay a whole number (the pitch curve closes only then)",
     "pitch_curve.teeth": "an integer (the search is continuous)",
-    "train.n": "it changes no metric (only the converted ratios of train 1)",
+    "train.n": "it changes no metric (only train 1's sets and the drive, the housings round "
+               "them not yet screened)",
     "field.carrier_speed_rpm": "it changes no metric (only the speeds in mm/s)",
     "housing.axial_gap": "it changes no metric (the envelope circles are radial)",
 }
@@ -90,7 +91,9 @@ class HousingRule:
     Gearbox 1 holds the circular train (module ``m_c``: the file's
     ``gears.circular_module``, or the largest 0.05-mm step from 5 mm giving every circular
     gear a whole count of at least 17 teeth, or, when none does, the non-circular module);
-    gearbox 2 the non-circular pair (module ``max(m_nc, m_c)``). Each housing's envelope is
+    gearbox 2 the non-circular pair (module ``max(m_nc, m_c)``); gearbox 1's circles the
+    larger of set II's and set I's gears on each axis (:meth:`holding_tips`). Each housing's
+    envelope is
     its clearance (given, or ``max(2, 0.75 m)``) + wall (given, or ``max(3, 1.5 m)``) + the
     flange of the wall's bolt. Called by the screen with the closed pairs of some rows.
     """
@@ -101,6 +104,9 @@ class HousingRule:
 
         housing = base_params.housing
         self.requested = base_params.gears.circular_module
+        self.n = float(base_params.train.n)
+        self.pressure_angle = base_params.gears.pressure_angle_rad
+        self.shifts = base_params.gears.profile_shift.resolved()
         self.columns = {k: np.asarray(v, dtype=float) for k, v in columns.items()}
         # the flange by the wall's bolt: one width per bolt size (a given bolt: one for all)
         self.wall_steps = np.array([below for below, _ in BOLT_BY_WALL])
@@ -117,8 +123,7 @@ class HousingRule:
             return np.full(len(rows), float(self.requested))
         from cadgen.gears.circular import MIN_CIRCULAR_TEETH
 
-        c = {k: self.columns[k][rows] for k in ("R", "i12", "i13", "r")}
-        radii = np.stack([c["R"], c["R"] * c["i12"], c["R"] * c["i13"], c["R"], c["r"]], axis=1)
+        radii = np.stack(self.set_two(rows) + [self.columns["r"][rows]], axis=1)
         steps = np.arange(100, 9, -1)
         counts = 2.0 * radii[:, None, :] / (steps[None, :, None] * 0.05)
         whole = ((np.abs(counts - np.round(counts)) < 1e-6)
@@ -126,6 +131,37 @@ class HousingRule:
         first = whole.argmax(axis=1)
         module = np.round(steps[first] * 0.05, 10)
         return np.where(whole.any(axis=1), module, module_nc)
+
+    def set_two(self, rows) -> list:
+        """Set II's radii (sun, idlers on A and B, planet) of the rows, as
+        :func:`cadgen.gears.circular.train1_set_radii`: ``q = 2 / (n - 1)``, ``r_s = 2 R q /
+        (1 + q)`` (R, R i12, R i13, R for n = 3)."""
+        R, i12, i13 = (self.columns[k][rows] for k in ("R", "i12", "i13"))
+        q = 2.0 / (self.n - 1.0)
+        sun = 2.0 * R * q / (1.0 + q)
+        idler_a = R * (1.0 + i12) - sun
+        idler_b = R * (i12 + i13) - idler_a
+        return [sun, idler_a, idler_b, sun / q]
+
+    def holding_tips(self, rows) -> np.ndarray:
+        """(N, 4) tip radii of train 1's set I on O, A, B, C (its module, its computed shifts
+        or the file's, as :func:`cadgen.solids.housings.envelope_circles`); 0 where the set
+        cannot be cut. Row by row: the set's teeth and shifts are a small search each."""
+        from cadgen.gears.circular import TrainAxes, holding_set_design
+        from kinematics.errors import DesignError
+
+        keys = ("sun_I", "idler_1_I", "idler_2_I", "planet_I")
+        out = np.zeros((len(rows), 4))
+        R, i12, i13 = (self.columns[k][rows] for k in ("R", "i12", "i13"))
+        for row, axes in enumerate(zip(R, i12, i13)):
+            try:
+                design = holding_set_design(TrainAxes(*(float(v) for v in axes), self.n),
+                                            self.requested, self.pressure_angle)
+            except DesignError:
+                continue
+            out[row] = [radius + design.module * (1.0 + max(shift, self.shifts.get(key, 0.0), 0.0))
+                        for radius, shift, key in zip(design.reference_radii, design.shifts, keys)]
+        return out
 
     def _envelope(self, module, rows, field: str, low: float, factor: float):
         """The housing's clearance or wall: searched, given in the file, or from the module."""
@@ -149,8 +185,12 @@ class HousingRule:
         R, i12, i13, r = (self.columns[k][rows] for k in ("R", "i12", "i13", "r"))
         a, r_min, r_max = pair["centre_distance"], pair["radius_min"], pair["radius_max"]
         out1, out2 = envelope["gearbox1"], envelope["gearbox2"]
-        derived = {("gearbox1", "O"): R + module_c + out1, ("gearbox1", "A"): R * i12 + module_c + out1,
-                   ("gearbox1", "B"): R * i13 + module_c + out1, ("gearbox1", "C"): R + module_c + out1,
+        one = self.holding_tips(rows)   # set I's tips on O, A, B, C where it is larger
+        two = self.set_two(rows)
+        derived = {("gearbox1", "O"): np.maximum(two[0] + module_c, one[:, 0]) + out1,
+                   ("gearbox1", "A"): np.maximum(two[1] + module_c, one[:, 1]) + out1,
+                   ("gearbox1", "B"): np.maximum(two[2] + module_c, one[:, 2]) + out1,
+                   ("gearbox1", "C"): np.maximum(two[3] + module_c, one[:, 3]) + out1,
                    ("gearbox2", "C"): r_max + module_nc + out2,
                    ("gearbox2", "D"): np.maximum(a - r_min + module_nc, r + module_c) + out2,
                    ("gearbox2", "E"): r + module_c + out2}

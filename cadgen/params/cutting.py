@@ -7,7 +7,9 @@ the module, positive away from the gear's centre), e.g. ``profile_shift = { inte
 
 * planting: ``central``, ``intermediate`` (the non-circular pair), ``gear_D``,
   ``planet_gear_E`` (gearbox 2's 1:1 pair), ``sun``, ``idler_1``, ``idler_2``,
-  ``train_1_planet`` (train 1);
+  ``train_1_planet`` (train 1's set II), ``sun_I``, ``idler_1_I``, ``idler_2_I``, ``planet_I``
+  (set I), ``input_gear_1``, ``central_shaft_gear``, ``input_gear_2``,
+  ``transmission_driven_gear`` (the frame's drive);
 * pricking: ``sun``, ``intermediate_1``, ``intermediate_2``, ``planet``.
 
 Shifts are V-zero: within each pair in mesh the two shifts sum to zero, so the pitch curves
@@ -38,7 +40,10 @@ __all__ = ["CuttingParameters", "PlantingCuttingParameters", "ShiftTable", "Plan
 
 #: The planting mechanism's pairs in mesh, as ``gears.profile_shift`` keys (cadgen.gears.trains).
 PLANTING_MESHES = (("central", "intermediate"), ("gear_D", "planet_gear_E"), ("sun", "idler_1"),
-                   ("idler_1", "idler_2"), ("idler_2", "train_1_planet"))
+                   ("idler_1", "idler_2"), ("idler_2", "train_1_planet"), ("sun_I", "idler_1_I"),
+                   ("idler_1_I", "idler_2_I"), ("idler_2_I", "planet_I"),
+                   ("input_gear_1", "central_shaft_gear"),
+                   ("input_gear_2", "transmission_driven_gear"))
 #: The pricking mechanism's (the two intermediates share a shaft, not a mesh).
 PRICKING_MESHES = (("sun", "intermediate_1"), ("intermediate_2", "planet"))
 
@@ -180,6 +185,14 @@ class PlantingShifts(ShiftTable):
     idler_1: float | None = _shift("train-1 first idler")
     idler_2: float | None = _shift("train-1 second idler")
     train_1_planet: float | None = _shift("train-1 planet")
+    sun_I: float | None = _shift("train-1 set-I sun")
+    idler_1_I: float | None = _shift("train-1 set-I first idler")
+    idler_2_I: float | None = _shift("train-1 set-I second idler")
+    planet_I: float | None = _shift("train-1 set-I planet")
+    input_gear_1: float | None = _shift("drive input gear 1")
+    central_shaft_gear: float | None = _shift("drive central shaft gear")
+    input_gear_2: float | None = _shift("drive input gear 2")
+    transmission_driven_gear: float | None = _shift("drive transmission driven gear")
 
 
 class PrickingShifts(ShiftTable):

@@ -114,6 +114,10 @@ def _bought_rows(drivetrain, housings: dict, copies: dict, gears: set) -> list:
                         f"({bearing.bore:g} x {bearing.outside:g} x {bearing.width:g} mm)")
                 bearings[name] += 2 * n
                 describe[name] = ("bearing", bearing.designation)
+        coupling = getattr(shaft, "coupling_key", None)
+        if coupling is not None and shaft.side == 1:   # the stub's key, for the input's hub
+            keys[coupling.designation] += 1
+            describe[coupling.designation] = ("key", coupling.designation)
         flange = getattr(shaft, "flange", None)
         if flange and shaft.side == 1:   # the carrying flange's screws, per copy of the shaft
             sides = sum(1 for s in drivetrain.shafts if s.name == shaft.name)

@@ -75,19 +75,21 @@ def housing_circles(params, mechanism) -> list:
         mechanism, mechanism.module(params.pitch_curve.teeth), shells["gearbox2"].envelope,
         circular_module=shells["gearbox1"].module, gearbox1_allowance=shells["gearbox1"].envelope,
         shifts=params.gears.profile_shift.resolved(),
-        holding_module=_holding_module(params, mechanism))
+        holding=_holding_set(params, mechanism))
     explicit = {"gearbox1": params.housing.gearbox1 or {}, "gearbox2": params.housing.gearbox2 or {}}
     return [HousingCircle(c.gearbox, c.point, float(explicit[c.gearbox].get(c.point, c.radius)))
             for c in circles]
 
 
-def _holding_module(params, mechanism):
-    """Set I's module as the teeth stage cuts it, or None when it cannot be cut."""
-    from cadgen.gears.circular import holding_set_module
+def _holding_set(params, mechanism):
+    """Set I as the teeth stage cuts it (:func:`cadgen.gears.circular.holding_set_design`), or
+    None when it cannot be cut."""
+    from cadgen.gears.circular import holding_set_design
     from kinematics.errors import DesignError
 
     try:
-        return holding_set_module(mechanism, params.gears.circular_module)
+        return holding_set_design(mechanism, params.gears.circular_module,
+                                  params.gears.pressure_angle_rad)
     except DesignError:
         return None
 
@@ -95,7 +97,7 @@ def _holding_module(params, mechanism):
 def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: float, *,
                             circular_module: float | None = None,
                             gearbox1_allowance: float | None = None, shifts=None,
-                            holding_module: float | None = None):
+                            holding=None):
     """Envelope circles of both gearboxes: the largest gear tip about each axis plus ``allowance``.
 
     Gearbox 2 holds the non-circular pair and the 1:1 pair: at C the central
@@ -124,19 +126,19 @@ def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: flo
     box2 = {"C": r_max + tip("central", module) + allowance,
             "D": max(a - r_min + tip("intermediate", module), r + tip("gear_D", m_c)) + allowance,
             "E": r + tip("planet_gear_E", m_c) + allowance}
-    from cadgen.gears.circular import holding_set_module, train1_set_radii
-    from kinematics.errors import DesignError
+    from cadgen.gears.circular import train1_set_radii
 
     two = train1_set_radii(mechanism, "II")
     box1 = {"O": two[0] + tip("sun", m_c) + outer1, "A": two[1] + tip("idler_1", m_c) + outer1,
             "B": two[2] + tip("idler_2", m_c) + outer1,
             "C": two[3] + tip("train_1_planet", m_c) + outer1}
-    try:   # set I (it holds the central gear) shares the axes: the larger gear on each
-        m_i = holding_module or holding_set_module(mechanism, None)
-        one = train1_set_radii(mechanism, "I")
-        for axis, radius in zip("OABC", one):
-            box1[axis] = max(box1[axis], radius + m_i + outer1)
-    except DesignError:   # the set cannot be cut: the teeth stage says why
-        pass
+    if holding is not None:   # set I (it holds the central gear) shares the axes: the larger
+        for axis, radius, key, shift in zip("OABC", holding.reference_radii,
+                                            ("sun_I", "idler_1_I", "idler_2_I", "planet_I"),
+                                            holding.shifts):
+            # its tip: the reference radius plus one module, grown by a positive shift (its
+            # own, computed for the axis distances, or the file's)
+            grown = holding.module * max(shift, shifts.get(key, 0.0), 0.0)
+            box1[axis] = max(box1[axis], radius + holding.module + grown + outer1)
     return ([HousingCircle("gearbox1", p, v) for p, v in box1.items()]
             + [HousingCircle("gearbox2", p, v) for p, v in box2.items()])

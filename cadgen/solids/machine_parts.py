@@ -49,7 +49,7 @@ def housing_bolt(params, wall: float) -> tuple:
 
 
 def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: float, segments: int,
-                  path: str = "housing"):
+                  path: str = "housing", passages=(), tapped=()):
     """The split housing of one stack round some swept discs.
 
     Parameters
@@ -63,6 +63,8 @@ def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: floa
     stack : HousingStack
         End walls, cavity height, parting plane (from the cavity floor).
     seats : sequence of BearingSeat
+    passages, tapped : sequence
+        Holes with no bearing: :func:`~cadgen.solids.split_housing.split_housing`'s.
     z_cavity_bottom : float
         The cavity floor's height in the body frame (mm).
     segments : int
@@ -80,7 +82,8 @@ def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: floa
                          cavity_height=stack.cavity_height, z_cavity_bottom=z_cavity_bottom,
                          parting_z=z_cavity_bottom + stack.parting_z,
                          seats=seats, bolt_size=size,
-                         bolt_hole_diameter=hole, segments=segments, path=path)
+                         bolt_hole_diameter=hole, segments=segments, path=path,
+                         passages=passages, tapped=tapped)
 
 
 def housing_parts(name: str, housing, body: str, instances=None) -> list:
@@ -169,10 +172,10 @@ def shaft_ends(shaft, housing) -> tuple:
             continue
         if seat.wall == "floor":
             bottom = (z0 - housing.floor_wall - shaft.extends_below if seat.through
-                      else z0 - seat.bearing.width)
+                      else z0 - seat.depth)
         elif seat.wall == "roof":
             top = (z_cavity_top + housing.roof_wall + shaft.extends_above if seat.through
-                   else z_cavity_top + seat.bearing.width)
+                   else z_cavity_top + seat.depth)
     return bottom, top
 
 
@@ -201,7 +204,9 @@ def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=
     z_bottom, z_top = shaft_ends(shaft, housing)
     gears = {name: value for name, value in (gears or {}).items()
              if name in {mount.gear for mount in shaft.mounts}}
-    first = next((gears[m.gear][0] for m in shaft.mounts if m.gear in gears), None)
+    # the shaft turns with its keyed gears (a gear running free on its bearings does not)
+    first = next((gears[m.gear][0] for m in shaft.mounts
+                  if m.gear in gears and getattr(m, "bearing", None) is None), None)
     frame0 = _turn_of(first(0.0)) if first is not None else 0.0
 
     def direction(mount) -> float:
@@ -220,6 +225,12 @@ def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=
                              mount.key.shaft_depth, direction(mount)))
         if float(mount.flat_depth or 0.0) > flat:
             flat, flat_angle = float(mount.flat_depth), direction(mount)
+    coupling = getattr(shaft, "coupling_key", None)
+    if coupling is not None:   # the stub's keyseat, centred on the stub below the floor
+        stub_top = housing.z_cavity_bottom - housing.floor_wall
+        middle = 0.5 * (z_bottom + stub_top)
+        keyseats.append((middle - coupling.length / 2, middle + coupling.length / 2,
+                         coupling.width, coupling.shaft_depth, 0.0))
     solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
                         flat_angle=flat_angle, segments=segments)
     if getattr(shaft, "bore", 0.0) > 0.0:

@@ -164,7 +164,8 @@ def body_poses(mechanism, layout):
 # ------------------------------------------------------------------ parts
 def _gear_parts(params, mechanism, train, layout, segments):
     """Every gear of both trains, in its body, turning with the carrier angle: ``(parts,
-    frames)``, ``frames`` each gear's ``(placement, keyway angle)`` for its shaft's keyseat."""
+    frames)``, ``frames`` each gear's ``{body: (placement, keyway angle)}`` for its shaft's
+    keyseat, in its own body and (a gearbox-2 gear) in carrier 1's (:func:`_in_carrier`)."""
     from cadgen.gears.trains import _placements
 
     from cadgen.gears.circular import TRAIN1_SETS, train1_set_radii
@@ -230,8 +231,27 @@ def _gear_parts(params, mechanism, train, layout, segments):
                      ((profile.file_stem + "-side1", "carrier1", 0.0),
                       (profile.file_stem + "-side2", "carrier1:mirrored", 0.0)))
         parts.append(Part(profile.file_stem, "gear", body, solid, local, instances, outline))
-        frames[profile.name] = (local, float(profile.notes.get("keyway_angle_rad", 0.0)))
+        frames[profile.name] = _in_carrier(body, local, start, float(
+            profile.notes.get("keyway_angle_rad", 0.0)))
     return parts, frames
+
+
+def _in_carrier(body, local, start, keyway):
+    """A gear's ``(placement, keyway)`` for the keyseat of its shaft; a gearbox-2 gear (the
+    central gear, whose shaft C2 rides on carrier 1) also as seen from carrier 1's body:
+    ``{"gearbox2": ..., "carrier1": ...}`` by the shaft's body."""
+    if body != "gearbox2":
+        return {body: (local, keyway)}
+
+    def seen_from_carrier(phi, local=local):
+        return np.linalg.solve(start("carrier1", phi), start("gearbox2", phi) @ local(phi))
+
+    return {"gearbox2": (local, keyway), "carrier1": (seen_from_carrier, keyway)}
+
+
+def _frames_for(frames, body: str) -> dict:
+    """Each gear's placement and keyway in ``body`` (where known): a shaft's ``gears``."""
+    return {name: views[body] for name, views in (frames or {}).items() if body in views}
 
 
 def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetrain,
@@ -255,12 +275,17 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
         for axis in ("A", "B", "C"):
             x, y = sign * carrier[axis] * line
             discs1.append((x, y, radius["gearbox1", axis] - box1.envelope))
+    holes = floor_holes(drivetrain)
+    passages1, tapped1 = holes.get("gearbox1", ((), ()))
+    passages2, tapped2 = holes.get("gearbox2", ((), ()))
     housing1 = stack_housing(params, discs1, box1, drivetrain.stacks["gearbox1"],
                              drivetrain.seats("gearbox1"), z_cavity_bottom=layout.box1_floor,
-                             segments=segments, path="housing.gearbox1")
+                             segments=segments, path="housing.gearbox1", passages=passages1,
+                             tapped=tapped1)
     housing2 = stack_housing(params, discs2, box2, drivetrain.stacks["gearbox2"],
                              drivetrain.seats("gearbox2"), z_cavity_bottom=layout.box2_floor,
-                             segments=segments, path="housing.gearbox2")
+                             segments=segments, path="housing.gearbox2", passages=passages2,
+                             tapped=tapped2)
     arms = lambda stem: ((f"{stem}-arm1", "gearbox2", 0.0), (f"{stem}-arm2", "gearbox2", math.pi))
     # a printed half too big for the printer comes in bolted segments; the splices stay on
     # the housing record (the bill of materials counts their bolts)
@@ -275,20 +300,19 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
             parts.append(shaft_part(shaft, housing2, "gearbox2", instances=arms(f"shaft-{shaft.name}"),
-                                    segments=segments, gears=gears))
+                                    segments=segments, gears=_frames_for(gears, "gearbox2")))
         elif shaft.housing == "gearbox1" and shaft.side == 1:
             stem = f"shaft-{shaft.name}"
             instances = ((f"{stem}-side1", "carrier1", 0.0),)
             if (shaft.name, 2) in sides:
                 instances += ((f"{stem}-side2", "carrier1:mirrored", 0.0),)
             parts.append(shaft_part(shaft, housing1, "carrier1", instances=instances,
-                                    segments=segments, gears=gears))
+                                    segments=segments, gears=_frames_for(gears, "carrier1")))
     housings = (housing1, housing2)
     if "frame" in drivetrain.stacks:
         frame, frame_parts = _frame_parts(params, mechanism, drivetrain, layout, segments, gears)
         parts += frame_parts
         housings += (frame,)
-    parts = _drilled(parts, drivetrain, layout, segments)
     return parts, housings
 
 
@@ -300,7 +324,9 @@ def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
     """The frame (the transmission box): a split housing round the drive's two pairs, fixed,
     with its shafts (the central shaft O, the sleeve S carrying gearbox 1, the input)."""
     from cadgen.solids.housings import ShellSize, flange_width
-    from cadgen.solids.machine_parts import housing_parts, shaft_part, stack_housing
+    from dataclasses import replace
+
+    from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
 
     drive = drivetrain.drive
     module = drive.module_1
@@ -308,73 +334,91 @@ def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
     wall = housing.wall_for(module)
     shell = ShellSize(housing.clearance_for(module), wall, housing.axial_gap, module,
                       flange_width(params, wall))
-    tip = [r + module for r in drive.radii]
+    shifts = params.gears.profile_shift.resolved()
+    keys = ("input_gear_1", "central_shaft_gear", "input_gear_2", "transmission_driven_gear")
+    # each gear's tip: one module, grown by a positive profile shift
+    tip = [r + module * (1.0 + max(shifts.get(key, 0.0), 0.0))
+           for r, key in zip(drive.radii, keys)]
     discs = [(0.0, 0.0, max(tip[1], tip[3])), (-drive.centre_distance, 0.0, max(tip[0], tip[2]))]
-    frame = stack_housing(params, discs, shell, drivetrain.stacks["frame"],
-                          drivetrain.seats("frame"), z_cavity_bottom=layout.frame_floor,
-                          segments=segments, path="housing.frame")
-    parts = housing_parts("frame", frame, "frame")
+    seats = drivetrain.seats("frame")
+    floor = drivetrain.stacks["frame"].floor_wall
+    frame = stack_housing(params, discs, shell, drivetrain.stacks["frame"], seats,
+                          z_cavity_bottom=layout.frame_floor, segments=segments,
+                          path="housing.frame",
+                          tapped=mounting_holes(discs, shell, seats, floor, segments))
+    # printed: cut into bolted segments when too big for the printer, like the gearboxes
+    parts, joints = printed_housing_parts("frame", frame, "frame", params)
+    frame = replace(frame, joints=tuple(joints))
     for shaft in drivetrain.shafts:
         if shaft.housing != "frame":
             continue
         body = "frame" if shaft.name == "input" else "carrier1"
         stem = f"shaft-{shaft.name}"
         parts.append(shaft_part(shaft, frame, body, instances=((stem, body, 0.0),),
-                                segments=segments, gears=gears))
+                                segments=segments, gears=_frames_for(gears, body)))
     return frame, parts
 
 
-def _drilled(parts, drivetrain, layout, segments):
-    """Holes the seats do not make: where a shaft passes a floor with no bearing of its own
-    (O through gearbox 1's, C2 through gearbox 2's) and the tapped holes of the flanges that
-    carry gearbox 1 (the sleeve S) and gearbox 2 (the hollow shaft C)."""
-    from dataclasses import replace as _replace
+#: The frame's mounting to the transplanter: tapped holes in its floor, from below.
+FRAME_MOUNT_BOLT, FRAME_MOUNT_HOLES = "M8", 4
 
-    from cadgen.solids.extrude import manifold3d_engine
-    from cadgen.solids.machine_parts import flange_bolt_holes
 
-    m3d = manifold3d_engine()
-    by = {(s.name, s.side): s for s in drivetrain.shafts}
-    cuts = {}
+def mounting_holes(discs, shell, seats, floor_wall: float, segments: int) -> tuple:
+    """The frame's mounting holes: ``FRAME_MOUNT_HOLES`` tapped ``FRAME_MOUNT_BOLT`` holes in its
+    floor, as far apart as the floor allows (the corners of its outline less the side wall and
+    1.5 bolt diameters), each clear of the floor's bearing seats by a bolt diameter, two bolt
+    diameters deep (at most the floor less 2 mm): the transplanter's frame bolts up into them."""
+    import shapely
+
+    from cadgen.solids.shell import shell_outlines
+
+    size = float(FRAME_MOUNT_BOLT.removeprefix("M"))
+    _, outer = shell_outlines(discs, clearance=shell.clearance, wall=shell.wall,
+                              segments=segments)
+    inner = shapely.Polygon(outer).buffer(-(shell.wall + 1.5 * size))
+    ring = np.asarray(inner.exterior.coords)[:-1]
+    floor_seats = [(np.asarray(seat.xy, dtype=float), seat.seat_diameter / 2)
+                   for seat in seats if seat.wall == "floor"]
+    clear = [p for p in ring
+             if all(np.linalg.norm(p - xy) >= radius + size for xy, radius in floor_seats)]
+    chosen = []
+    for direction in ((1, 1), (-1, 1), (-1, -1), (1, -1))[:FRAME_MOUNT_HOLES]:
+        if clear:
+            best = max(clear, key=lambda p: float(np.dot(p, direction)))
+            if all(np.linalg.norm(best - q) > 2 * size for q in chosen):
+                chosen.append(best)
+    drill = TAP_DRILL.get(FRAME_MOUNT_BOLT, 0.85 * size)
+    depth = min(2.0 * size, floor_wall - 2.0)
+    return tuple((float(x), float(y), drill, depth, "floor") for x, y in chosen)
+
+
+def floor_holes(drivetrain) -> dict:
+    """``{housing: (passages, tapped)}``: the holes the seats do not make, for
+    :func:`~cadgen.solids.split_housing.split_housing`. A shaft passing a floor with no bearing
+    of its own (O through gearbox 1's, C2 through gearbox 2's) passes a hole of its diameter
+    plus the running clearance; the flange that carries a housing (the sleeve S carries gearbox
+    1, the hollow shaft C gearbox 2) is screwed into tapped holes of its floor, two screw
+    diameters deep (at most the floor less 2 mm), on the flange's bolt circle about the axis."""
     clearance = drivetrain.rules.get("fits", {}).get("running_clearance_mm", 1.0)
-
-    def add(part, solid):
-        cuts[part] = solid if part not in cuts else cuts[part] + solid
-
-    floor1 = (layout.box1_floor - layout.box1_floor_wall, layout.box1_floor)
-    floor2 = (layout.box2_floor - layout.box2_floor_wall, layout.box2_floor)
-    for (name, side), shaft in by.items():
-        if side != 1:
+    floors = {name: stack.floor_wall for name, stack in drivetrain.stacks.items()}
+    out = {name: ([], []) for name in drivetrain.stacks}
+    for shaft in drivetrain.shafts:
+        if shaft.side != 1:
             continue
-        if name == "O":
-            z0, z1 = floor1
-            add("gearbox1-base", m3d.Manifold.cylinder(z1 - z0 + 2, (shaft.diameter + clearance)
-                                                       / 2, (shaft.diameter + clearance) / 2,
-                                                       segments).translate((0, 0, z0 - 1)))
-        if name == "C2":
-            z0, z1 = floor2
-            add("gearbox2-base", m3d.Manifold.cylinder(z1 - z0 + 2, (shaft.diameter + clearance)
-                                                       / 2, (shaft.diameter + clearance) / 2,
-                                                       segments).translate((0, 0, z0 - 1)))
-        if shaft.flange:
-            target = "gearbox1-base" if shaft.flange["carries"] == "gearbox1" else "gearbox2-base"
-            z0, z1 = floor1 if target == "gearbox1-base" else floor2
-            depth = min(z1 - z0 - 2.0, 2.0 * float(shaft.flange["bolt"].removeprefix("M")))
-            holes = flange_bolt_holes(shaft.flange, depth, segments,
-                                      diameter=TAP_DRILL.get(shaft.flange["bolt"], 5.0))
-            add(target, holes.translate((0, 0, z0)))
-    if not cuts:
-        return parts
-    out = []
-    for part in parts:
-        stem = part.name
-        key = next((k for k in cuts if stem == k or stem.startswith(k + "-")), None)
-        if key is None:
-            out.append(part)
-            continue
-        # gearbox 2's holes are at C, the origin of its body; gearbox 1's at O, its origin
-        out.append(_replace(part, solid=part.solid - cuts[key]))
-    return out
+        passes = {"O": "gearbox1", "C2": "gearbox2"}.get(shaft.name)
+        if passes in out:
+            out[passes][0].append((0.0, 0.0, shaft.diameter + clearance, "floor"))
+        flange = shaft.flange
+        if flange and flange["carries"] in out:
+            size = float(flange["bolt"].removeprefix("M"))
+            depth = min(2.0 * size, floors[flange["carries"]] - 2.0)
+            for k in range(int(flange["bolts"])):
+                angle = 2 * math.pi * k / int(flange["bolts"])
+                out[flange["carries"]][1].append(
+                    (flange["bolt_circle_radius"] * math.cos(angle),
+                     flange["bolt_circle_radius"] * math.sin(angle),
+                     TAP_DRILL.get(flange["bolt"], 0.8 * size), depth, "floor"))
+    return {name: (tuple(p), tuple(t)) for name, (p, t) in out.items()}
 
 
 def cam_bore_radius(params, drivetrain) -> float:

@@ -135,6 +135,10 @@ class SplitHousing:
     seats: tuple
     segments: int
     joints: tuple = ()
+    # holes with no bearing: ``(x, y, diameter, wall)`` through a wall (a shaft passing it),
+    # ``(x, y, diameter, depth, wall)`` tapped from the wall's outer face (a flange's screws)
+    passages: tuple = ()
+    tapped: tuple = ()
 
     @property
     def solid(self):
@@ -170,15 +174,28 @@ class SplitHousing:
                   - signed_area(self.cavity_outline) * self.cavity_height)
         for seat in self.seats:
             wall = self.floor_wall if seat.wall == "floor" else self.roof_wall
-            depth = seat.bearing.width
+            depth = _depth(seat)
             volume -= signed_area(circle(seat.seat_diameter / 2, self.segments, seat.xy)) * depth
             if seat.through:
                 volume -= (signed_area(circle(seat.hole_diameter / 2, self.segments, seat.xy))
                            * (wall - depth))
+        for x, y, diameter, wall in self.passages:
+            volume -= (signed_area(circle(diameter / 2, self.segments, (x, y)))
+                       * (self.floor_wall if wall == "floor" else self.roof_wall))
+        for x, y, diameter, depth, _ in self.tapped:
+            volume -= signed_area(circle(diameter / 2, TAPPED_SEGMENTS, (x, y))) * depth
         return volume
 
 
 # ------------------------------------------------------------------ rules
+#: Sides of a tapped hole's polygon (a few mm across: its chord error is below 0.01 mm).
+TAPPED_SEGMENTS = 48
+
+
+def _depth(seat) -> float:
+    """How deep a seat is bored: its bearings side by side (a pair: two widths)."""
+    return float(getattr(seat, "depth", seat.bearing.width))
+
 
 
 def bolt_nominal_diameter(bolt_size: str) -> float:
@@ -249,7 +266,7 @@ def _seat_problems(seats, outer_outline, floor_wall, roof_wall, path, segments):
                                     f"a seat's wall is 'floor' or 'roof', not {seat.wall!r}"))
             continue
         wall = floor_wall if seat.wall == "floor" else roof_wall
-        depth, diameter = float(seat.bearing.width), float(seat.seat_diameter)
+        depth, diameter = _depth(seat), float(seat.seat_diameter)
         if not (math.isfinite(diameter) and diameter > 0 and math.isfinite(depth) and depth > 0):
             problems.append(Problem(where, "seat_not_positive",
                                     f"the seat is {diameter!r} mm wide and {depth!r} mm deep; "
@@ -314,7 +331,8 @@ def _split_problems(circles, cavity_height, clearance, wall, floor_wall, roof_wa
 def split_housing(circles, *, clearance: float, wall: float, floor_wall: float, roof_wall: float,
                   cavity_height: float, z_cavity_bottom: float, parting_z: float, seats=(),
                   bolt_size: str, bolt_hole_diameter: float, segments: int,
-                  path: str = "housing", min_wall: float = MIN_WALL) -> SplitHousing:
+                  path: str = "housing", min_wall: float = MIN_WALL, passages=(),
+                  tapped=()) -> SplitHousing:
     """A housing round some gears' swept discs, parted into a base and a cover.
 
     Parameters
@@ -410,7 +428,7 @@ def split_housing(circles, *, clearance: float, wall: float, floor_wall: float, 
     # is exact. The base's slabs end at the parting plane, the cover's start there.
     voids = [(cavity_outline, z_cavity_bottom, z_cavity_top)]
     for seat in seats:
-        depth = float(seat.bearing.width)
+        depth = _depth(seat)
         seat_disc = circle(seat.seat_diameter / 2, segments, seat.xy)
         hole = circle(seat.hole_diameter / 2, segments, seat.xy) if seat.through else None
         if seat.wall == "floor":
@@ -421,6 +439,16 @@ def split_housing(circles, *, clearance: float, wall: float, floor_wall: float, 
             voids.append((seat_disc, z_cavity_top, z_cavity_top + depth))
             if hole is not None:
                 voids.append((hole, z_cavity_top + depth, z_top))
+    passages = tuple((float(x), float(y), float(d), str(w)) for x, y, d, w in passages)
+    tapped = tuple((float(x), float(y), float(d), float(h), str(w)) for x, y, d, h, w in tapped)
+    for x, y, diameter, wall_name in passages:
+        disc = circle(diameter / 2, segments, (x, y))
+        voids.append((disc, z_bottom, z_cavity_bottom) if wall_name == "floor"
+                     else (disc, z_cavity_top, z_top))
+    for x, y, diameter, depth, wall_name in tapped:
+        disc = circle(diameter / 2, TAPPED_SEGMENTS, (x, y))
+        voids.append((disc, z_bottom, z_bottom + depth) if wall_name == "floor"
+                     else (disc, z_top - depth, z_top))
     levels = sorted({z_bottom, z_top, parting_z, *flange_z,
                      *(z for _, a, b in voids for z in (a, b))})
 
@@ -460,7 +488,7 @@ def split_housing(circles, *, clearance: float, wall: float, floor_wall: float, 
                         roof_wall=roof_wall, parting_z=parting_z, bolt_positions=bolts,
                         bolt_hole_diameter=bolt_hole_diameter, bolt_size=str(bolt_size),
                         flange_thickness=half, flange_z=flange_z, seats=seats,
-                        segments=segments)
+                        segments=segments, passages=passages, tapped=tapped)
 
 
 def split_encloses(housing, part, *, volume_atol: float = ENCLOSURE_VOLUME_ATOL) -> tuple[bool, float]:

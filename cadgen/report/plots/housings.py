@@ -232,7 +232,7 @@ def _section(housing, centre, direction) -> dict:
         width = chord(seat.xy, float(seat.seat_diameter))
         if width is None:
             continue
-        depth = float(seat.bearing.width)
+        depth = float(getattr(seat, "depth", seat.bearing.width))   # a pair: two widths
         floor = seat.wall == "floor"
         z = (cavity_low - depth, cavity_low) if floor else (cavity_high, cavity_high + depth)
         voids.append(shapely.box(width[0], z[0], width[1], z[1]))
@@ -245,6 +245,16 @@ def _section(housing, centre, direction) -> dict:
         width = chord(xy, float(housing.bolt_hole_diameter))
         if width is not None:
             voids.append(shapely.box(width[0], flange_low, width[1], flange_high))
+    for x, y, diameter, wall in getattr(housing, "passages", ()):   # a shaft passing a wall
+        width = chord((x, y), float(diameter))
+        if width is not None:
+            voids.append(shapely.box(width[0], z_bottom if wall == "floor" else cavity_high,
+                                     width[1], cavity_low if wall == "floor" else z_top))
+    for x, y, diameter, depth, wall in getattr(housing, "tapped", ()):   # a flange's screws
+        width = chord((x, y), float(diameter))
+        if width is not None:
+            voids.append(shapely.box(width[0], z_bottom if wall == "floor" else z_top - depth,
+                                     width[1], z_bottom + depth if wall == "floor" else z_top))
     material = shapely.union_all(solid).difference(shapely.union_all(voids))
     far = reach + abs(z_bottom) + abs(z_top)
     base = material.intersection(shapely.box(-far, -far, far, housing.parting_z))
@@ -312,6 +322,11 @@ def _draw_plan(ax, housing, *, turned=False, line=None, scale=None) -> dict:
     for seat in housing.seats:
         groups.setdefault(tuple(np.round(np.asarray(seat.xy, dtype=float), 6)), []).append(seat)
     drawn_circles = set()
+    for x, y, diameter, _ in getattr(housing, "passages", ()):
+        h, v = (float(c[0]) for c in view((x, y)))
+        drawn["through_holes"].append(_circle(
+            ax, (h, v), float(diameter) / 2, facecolor=_HOLE, edgecolor="k", linewidth=0.6,
+            zorder=4, label=None if drawn["through_holes"] else "through hole (shaft leaves)"))
     for position, seats in groups.items():
         h, v = (float(c[0]) for c in view(position))
         for seat in seats:
