@@ -45,6 +45,7 @@ def planting_solids():
     from cadgen.cam.design import design_cam
     from cadgen.design import build_mechanism, evaluate
     from cadgen.gears.trains import planting_train
+    from cadgen.machine.drivetrain import drivetrain
     from cadgen.params import load_params
     from cadgen.solids.planting import planting_assembly
 
@@ -52,9 +53,11 @@ def planting_solids():
     mechanism = build_mechanism(params)
     evaluation = evaluate(params, mechanism, steps=720)
     cam = design_cam(params, mechanism, evaluation.events)
-    train = planting_train(params, mechanism)
+    machine = drivetrain(params, mechanism)
+    train = planting_train(params, mechanism, drive=machine.drive)   # as a build cuts it
     assembly, housings, layout = planting_assembly(params, mechanism, train, cam,
-                                                   evaluation.events.soil_level)
+                                                   evaluation.events.soil_level,
+                                                   drivetrain=machine)
     return params, mechanism, evaluation, cam, train, assembly, housings, layout
 
 

@@ -138,7 +138,8 @@ def test_each_gear_sits_on_its_shaft_axis(built):
 
     mechanism = build_mechanism(params)
     shafts = drivetrain(params, mechanism)
-    assembly, _, _ = planting_assembly(params, mechanism, planting_train(params, mechanism), None,
+    assembly, _, _ = planting_assembly(params, mechanism,
+                                       planting_train(params, mechanism, drive=shafts.drive), None,
                                        0.0, drivetrain=shafts)
     parts = {p.name: p for p in assembly.parts}
     checked = 0
@@ -194,7 +195,7 @@ def test_each_keyseat_lies_under_its_gears_keyway_at_every_pose(built):
 
     mechanism = build_mechanism(params)
     shafts = drivetrain(params, mechanism)
-    train, _ = hub_train(planting_train(params, mechanism), shafts)
+    train, _ = hub_train(planting_train(params, mechanism, drive=shafts.drive), shafts)
     assembly, _, _ = planting_assembly(params, mechanism, train, None, 0.0, drivetrain=shafts)
     parts = {p.name: p for p in assembly.parts}
     holes = {profile.name: profile.hole for profile, *_ in train.gears}

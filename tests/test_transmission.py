@@ -22,8 +22,9 @@ def paper():
 @pytest.fixture(scope="module")
 def train(paper):
     from cadgen.gears.trains import planting_train
+    from cadgen.machine.drivetrain import drivetrain
 
-    return planting_train(*paper)
+    return planting_train(*paper, drive=drivetrain(*paper).drive)   # as a build cuts it
 
 
 def test_set_i_of_the_paper_by_hand(train):

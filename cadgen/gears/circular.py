@@ -396,19 +396,23 @@ def planting_modules(mechanism, teeth: int, requested=None) -> tuple:
 
 
 #: The sleeve's outside diameter the drive's driven gear is designed round (mm): the largest
-#: the sleeve takes (its journal in a 6008); the drivetrain checks the chosen sleeve against it.
-DRIVE_SLEEVE_DIAMETER = 40.0
+#: the sleeve takes (its journal in a 6010, the catalogue's largest bore); the drivetrain
+#: checks the chosen sleeve against it.
+DRIVE_SLEEVE_DIAMETER = 50.0
 
 
 def planting_drive(mechanism, module_c: float, requested=None, carrier_rpm: float = 30.0,
-                   pressure_angle: float = math.radians(20.0)):
+                   pressure_angle: float = math.radians(20.0), hubs=(0.0, 0.0, 0.0, 0.0)):
     """The frame's drive of a planting design: :func:`cadgen.gears.drive.drive_design` at n with
     the larger of train 1's two modules (``module_c`` set II's, as :func:`planting_modules`
-    gives it; ``requested`` the file's ``gears.circular_module``)."""
+    gives it; ``requested`` the file's ``gears.circular_module``); ``hubs``: each gear's hub
+    diameter (input gear 1, the central shaft's, input gear 2, the driven gear's) its rim
+    must clear, once the drivetrain has sized their shafts."""
     from cadgen.gears.drive import drive_design
 
     try:
         module_i = holding_set_module(mechanism, requested, pressure_angle)
     except DesignError:
         module_i = module_c
-    return drive_design(mechanism.n, carrier_rpm, max(module_c, module_i), DRIVE_SLEEVE_DIAMETER)
+    return drive_design(mechanism.n, carrier_rpm, max(module_c, module_i), DRIVE_SLEEVE_DIAMETER,
+                        hubs=hubs)

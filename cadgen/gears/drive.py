@@ -108,13 +108,14 @@ def _positive(path: str, value, code: str = "drive_value_invalid") -> float:
 
 def drive_design(n: float, carrier_rpm: float, module: float, sleeve_diameter: float, *,
                  min_teeth: int = 17, max_teeth: int = 150,
-                 input_speed_ratio: float | None = None) -> DriveDesign:
+                 input_speed_ratio: float | None = None, hubs=(0.0, 0.0, 0.0, 0.0)) -> DriveDesign:
     """Choose ``(z1, z2, z3, z4)`` so that O turns at ``n`` times the carrier's speed.
 
     Both pairs are standard spur gears of module ``module``, so ``z1 + z2 == z3 + z4 == S``;
     every gear has ``min_teeth <= z <= max_teeth``. Rim rule: the driven gear z4's root circle
     must leave a rim around the hub sleeve,
-    ``m z4 / 2 - 1.25 m - sleeve_diameter / 2 >= 2.5 m``.
+    ``m z4 / 2 - 1.25 m - sleeve_diameter / 2 >= 2.5 m``; the same rule round each gear's hub
+    (``hubs``: the diameters its bore and keyway reach, ``d + 2 t2``, mm; 0: none known).
 
     S is searched from ``2 min_teeth`` to ``2 max_teeth`` and the choice minimises, in order:
     the relative ratio error ``|z1 z4 / (z2 z3) / n - 1|`` (below 1e-12 counts as exact); S;
@@ -147,14 +148,19 @@ def drive_design(n: float, carrier_rpm: float, module: float, sleeve_diameter: f
                                  f"need integers 1 <= min_teeth <= max_teeth, got "
                                  f"{min_teeth!r}, {max_teeth!r}")
     lo, hi = int(min_teeth), int(max_teeth)
-    # Rim rule solved for z4 (small slack against float noise in sleeve / m).
-    z4_min = max(lo, math.ceil(DEDENDUM_MODULES * 2 + RIM_MODULES * 2 + sleeve / m - 1e-9))
+    # Rim rule solved for each gear's least count (small slack against float noise in hub / m)
+    def least(hub):
+        return max(lo, math.ceil(DEDENDUM_MODULES * 2 + RIM_MODULES * 2 + hub / m - 1e-9))
+
+    hubs = tuple(float(h) for h in hubs)
+    z1_min, z2_min, z3_min = (least(h) for h in hubs[:3])
+    z4_min = least(max(sleeve, hubs[3]))
 
     best = None          # (key, teeth)
     ratio_max = ratio_min = None
     for s in range(2 * lo, 2 * hi + 1):
-        z1_lo, z1_hi = max(lo, s - hi), min(hi, s - lo)
-        z3_lo, z3_hi = max(lo, s - hi), min(hi, s - z4_min)
+        z1_lo, z1_hi = max(z1_min, s - hi), min(hi, s - z2_min)
+        z3_lo, z3_hi = max(z3_min, s - hi), min(hi, s - z4_min)
         if z1_lo > z1_hi or z3_lo > z3_hi:
             continue
         top = z1_hi * (s - z3_lo) / ((s - z1_hi) * z3_lo)

@@ -22,7 +22,7 @@ from kinematics.profile_shift import shift_key
 
 from cadgen.gears.advice import advise_train, planting_hints, pricking_hints
 from cadgen.gears.circular import (TRAIN1_SETS, _radius_hint, circular_module, holding_set_design,
-                                   planting_circular_radii, planting_drive, train1_set_radii)
+                                   planting_circular_radii, planting_drive)
 from cadgen.gears.pairs import (FAILING_PROBLEMS, MIN_ROOT_THICKNESS, PitchPair, circle_pair,
                                 generate_pair)
 from cadgen.gears.meshing import meshing_check, relieve_interference
@@ -196,11 +196,13 @@ def _report_to(progress, total):
     return cut
 
 
-def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
+def planting_train(params, mechanism, progress=None, cache=None, drive=None) -> GearTrain:
     """The planting mechanism's gears at the catching position (phi = 0).
 
     ``progress(done, total, pair name)``, optional, is called as each of the ten pairs is cut.
     ``cache``, a :class:`~cadgen.gears.cache.GearCache` or None, answers pairs cut before.
+    ``drive``: the frame's :class:`~cadgen.gears.drive.DriveDesign` as the drivetrain sized
+    it (``Drivetrain.drive``); None designs it from the parameters alone.
     """
     cut = _report_to(progress, 10)
     cutting = params.gears
@@ -240,7 +242,7 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
                                         cutting.pressure_angle_rad)
             set_radii, set_system = design.reference_radii, _system(cutting, design.module)
         counts = [int(round(2 * x / set_system.module)) for x in set_radii]
-        drive = None
+        carried = None   # a gear cut in one mesh, carried into the next
         for k in range(3):
             pair = circle_pair((names[k], names[k + 1]), set_radii[k], set_radii[k + 1])
             working, mesh_shifts, short = None, _shifts(shifts, pair), (0.0, 0.0)
@@ -250,11 +252,11 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
                 short = design.shortening[k], design.shortening[k + 1]
             stage = _stage(f"train 1 set {key}: {names[k]} to {names[k + 1]}", pair,
                            (counts[k], counts[k + 1]), set_system, cutting,
-                           (carrier, axes[k] * line), drive=drive, circular=True, cache=cache,
+                           (carrier, axes[k] * line), drive=carried, circular=True, cache=cache,
                            shifts=mesh_shifts, working=working, shortening=short)
             stages.append(stage)
             cut(stage.name)
-            drive = _carry(stage.generated)
+            carried = _carry(stage.generated)
         ratio = (-2.0 if key == "II" else -1.0) / (mechanism.n - 1.0)
         sets.append({"key": key, "name": set_name, "converted_ratio": ratio,
                      "rule": design.rule if design is not None else
@@ -262,9 +264,11 @@ def planting_train(params, mechanism, progress=None, cache=None) -> GearTrain:
                      "axes": ("O", "A", "B", "C"), "axis_distances": tuple(
                          float(axes[k + 1] - axes[k]) for k in range(3)),
                      "stages": tuple(s.name for s in stages[-3:])})
-    # the frame's drive: the input shaft turns the central shaft and carrier 1 the same way
-    drive = planting_drive(mechanism, module, cutting.circular_module,
-                           params.field.carrier_speed_rpm, cutting.pressure_angle_rad)
+    # the frame's drive: the input shaft turns the central shaft and carrier 1 the same way;
+    # the drivetrain's (designed round the shafts it sized) when given
+    if drive is None:
+        drive = planting_drive(mechanism, module, cutting.circular_module,
+                               params.field.carrier_speed_rpm, cutting.pressure_angle_rad)
     drive_system = _system(cutting, drive.module_1)
     origin = np.array([-drive.centre_distance, 0.0])
     for k, names in enumerate((("input gear 1", "central shaft gear"),

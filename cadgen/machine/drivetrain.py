@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 from kinematics.errors import Problem
 
-from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER
+from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, planting_modules
 from cadgen.machine.bearings import select_bearing
 from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
 from cadgen.machine.fits import process_fits
@@ -359,6 +359,34 @@ STUB_CHAMFER = 2.0
 FLANGE_SHEAR_ALLOW = 190.0
 
 
+#: Rounds of drive redesign round its shafts' hubs (each can only grow the gears).
+DRIVE_ROUNDS = 4
+
+
+def _hub_diameter(d: float, face: float) -> float:
+    """The diameter a keyed hub's bore and keyway reach on a shaft of ``d``: ``d + 2 t2``."""
+    try:
+        key = hub_key(d, face)
+    except CatalogueError:
+        return d
+    return d + 2 * key.hub_depth if key is not None else d
+
+
+def _drive_round_hubs(params, design, axes, sized, drive):
+    """The drive redesigned round the hubs of the shafts just sized, or None if it fits them."""
+    from cadgen.gears.circular import planting_drive
+
+    by_name = {axis.name: size for axis, size in zip(axes, sized) if axis.side == 1}
+    face = params.gears.face_width_for(drive.module_1)
+    hubs = tuple(_hub_diameter(by_name[name].diameter, face)
+                 for name in ("input", "O", "input", "S"))
+    module_c = planting_modules(design, params.pitch_curve.teeth, params.gears.circular_module)[1]
+    need = planting_drive(design, module_c, params.gears.circular_module,
+                          params.field.carrier_speed_rpm, params.gears.pressure_angle_rad,
+                          hubs=hubs)
+    return None if need.teeth == drive.teeth else need
+
+
 def _shaft_problems(axis, sized, given, machine, both_sides) -> list:
     problems = []
     d = sized.diameter
@@ -421,6 +449,16 @@ def drivetrain(params, design) -> Drivetrain:
     given = machine.shafts.given()
     sized, walls, iterations, converged = _fixed_point(axes, cavities, given, machine, bases,
                                                        fits.running_clearance)
+    for _ in range(DRIVE_ROUNDS if drive is not None else 0):
+        # the drive's gears sit on O, the sleeve and the input: their rims must clear the hubs
+        # of the shafts just sized; a larger gear changes the loads, so size again
+        bigger = _drive_round_hubs(params, design, axes, sized, drive)
+        if bigger is None:
+            break
+        drive = bigger
+        axes, cavities, loads, bases, drive = planting_axes(params, design, drive)
+        sized, walls, iterations, converged = _fixed_point(axes, cavities, given, machine,
+                                                           bases, fits.running_clearance)
     base = bases(walls)
     stacks = {name: HousingStack(name, walls[name][0], walls[name][1], c.height, c.parting_z,
                                  c.layers) for name, c in cavities.items()}

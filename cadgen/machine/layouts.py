@@ -100,7 +100,7 @@ def planting_bases(cavities, gap: float):
     return bases
 
 
-def planting_axes(params, mechanism) -> tuple:
+def planting_axes(params, mechanism, drive=None) -> tuple:
     from cadgen.gears.circular import holding_set_module, planting_drive
     from kinematics.errors import DesignError
 
@@ -114,8 +114,9 @@ def planting_axes(params, mechanism) -> tuple:
         module_i = module_c
     face_nc, face_c = gears.face_width_for(module_nc), gears.face_width_for(module_c)
     face_i = gears.face_width_for(module_i)
-    drive = planting_drive(mechanism, module_c, gears.circular_module,
-                           params.field.carrier_speed_rpm, gears.pressure_angle_rad)
+    if drive is None:   # the drivetrain redesigns it round its shafts' hubs when they grow
+        drive = planting_drive(mechanism, module_c, gears.circular_module,
+                               params.field.carrier_speed_rpm, gears.pressure_angle_rad)
     face_d = gears.face_width_for(drive.module_1)
     # gearbox 1: set I (it holds the central gear) below, set II (it carries gearbox 2) above:
     # the planet of set II is on the hollow shaft C, set I's on the shaft C2 inside it

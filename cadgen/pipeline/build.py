@@ -241,7 +241,10 @@ def _teeth(run):
     make = pricking_train if params.mechanism == "pricking" else planting_train
     asked = getattr(run, "cache", None)   # a run made outside build() has no cache
     cache = open_cache(asked)   # opened here: a scene without teeth never touches it
-    train = make(params, run.values["kinematics"], progress=cut, cache=cache)
+    options = {}
+    if params.mechanism == "planting" and run.status("drivetrain") == "ok":
+        options["drive"] = run.values["drivetrain"].drive   # designed round its shafts
+    train = make(params, run.values["kinematics"], progress=cut, cache=cache, **options)
     run.gear_cache = cache_record(cache, asked)   # hits and misses, for the report
     if run.status("drivetrain") == "ok" and train.stages:
         from cadgen.machine.hubs import hub_train

@@ -556,6 +556,11 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
         from cadgen.machine.drivetrain import drivetrain as compute_drivetrain
 
         drivetrain = compute_drivetrain(params, mechanism)
+    cut_for = getattr(train, "drive", None)
+    if cut_for is not None and drivetrain.drive is not None and cut_for != drivetrain.drive:
+        raise ValueError("the gear train was cut for another drive than the drivetrain's (its "
+                         f"teeth {cut_for.teeth}, the drivetrain's {drivetrain.drive.teeth}): "
+                         "cut it with planting_train(..., drive=drivetrain.drive)")
     segments = params.solids.segments_per_circle
     shells = planting_shells(params, mechanism)
     circles = housing_circles(params, mechanism)
