@@ -9,6 +9,7 @@ outlines with shapely; and a simulated rack cut whose rack is built here, not by
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -220,8 +221,36 @@ def test_a_v_zero_pair_meshes_with_the_backlash_it_is_given():
         # pitch circle stays the two gears' thinning, 2 x 0.05 mm
         assert report.backlash_arc_max == pytest.approx(2 * backlash, abs=2e-3)
         assert [c.profile_shift for c in generated.checks] == list(shifts)
+    # a non-circular pair's shifts must sum to zero: its pitch curves cannot move
+    contact_only = dataclasses.replace(pair, radii=None)
     with pytest.raises(ValueError, match="V-zero"):
-        generate_pair(pair, (20, 30), system=ToothSystem(module), shifts=(0.3, 0.1))
+        generate_pair(contact_only, (20, 30), system=ToothSystem(module), shifts=(0.3, 0.1))
+
+
+def test_a_v_pair_meshes_at_its_working_centre_distance_with_the_backlash_it_is_given():
+    """Circular gears may take any two shifts: cut on their reference circles, they mesh at the
+    working centre distance of ISO 21771 (the inverse of the involute function, solved by
+    Newton's method), tips shortened to the standard clearance. Each gear thinned by b on its
+    reference circle turns the wheel's free play to 2 b / r2; on its working circle, arc
+    2 b a_w / a."""
+    from cadgen.gears.circular import tip_shortening, working_shift_sum
+    from cadgen.gears.trains import working_centre_distance
+
+    module, backlash, alpha = 2.0, 0.05, math.radians(20.0)
+    for shifts in ((0.3, 0.1), (-0.2, -0.25), (0.5, -0.1)):
+        reference = circle_pair(("pinion", "wheel"), 20.0, 30.0)
+        a = 50.0
+        a_w = working_centre_distance(20, 30, module, sum(shifts), alpha)
+        # the forward rule gives back the shift sum at that distance
+        assert working_shift_sum(20, 30, module, a_w, alpha) == pytest.approx(sum(shifts),
+                                                                               abs=1e-12)
+        short = tip_shortening((20, 30), module, shifts, (a_w,), alpha)
+        generated = generate_pair(reference, (20, 30), system=ToothSystem(module, backlash=backlash),
+                                  shifts=shifts, shortening=short, flank_points=96)
+        working = circle_pair(reference.names, a_w * 20 / 50, a_w * 30 / 50)
+        report = meshing_check(*generated.profiles, working, poses=48, span=working.period / 20)
+        assert report.interference_poses == 0, shifts
+        assert report.backlash_arc_max == pytest.approx(2 * backlash * a_w / a, abs=2e-3), shifts
 
 
 def test_the_cache_key_holds_the_shift():

@@ -65,8 +65,9 @@ def test_report_renders_and_moves_in_chromium(browser, reports, design):
         assert page.evaluate("window.cadgenAnimations[0].frame") == held
         page.locator(".anim-slider").fill("90")
         assert page.locator(".cadgen-animation").get_attribute("data-frame") == "90"
-        # the housings' covers come off and back: gearbox 1's and each arm's gearbox 2's
-        covers = {"xin2024-planter": 3, "kernel-a": 1}[design]
+        # the housings' covers come off and back: the frame's, gearbox 1's and each arm's
+        # gearbox 2's
+        covers = {"xin2024-planter": 4, "kernel-a": 1}[design]
         assert page.evaluate("window.cadgenViewer.covers") == covers
         button = page.locator(".viewer-covers")
         button.click()

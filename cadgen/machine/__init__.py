@@ -17,6 +17,8 @@ loads
     The torque chain from the tool's tip load to every gear, and the shafts' speeds.
 layouts
     Where each axis is and what it carries, each housing's cavity, the housings' stack.
+fastening
+    Gears running free on their bearings, carrying flanges, stub couplings: sizes and checks.
 shafts
     The beam on two bearings, the diameter from torque and bending, keys and D-flats.
 bearings

@@ -20,7 +20,7 @@ import math
 from cadgen.machine.catalogue import bearings_with_bore
 from cadgen.machine.model import Bearing
 
-__all__ = ["BALL_EXPONENT", "l10_hours", "select_bearing"]
+__all__ = ["BALL_EXPONENT", "l10_hours", "select_bearing", "journal_bore"]
 
 #: ISO 281's life exponent for ball bearings.
 BALL_EXPONENT = 3.0
@@ -94,3 +94,15 @@ def select_bearing(d: float, load_n: float, rpm: float, life_min_h: float, *,
             return bearing, life, True
     strongest: Bearing = max(candidates, key=lambda b: b.dynamic_load_kn)
     return strongest, l10_hours(strongest.dynamic_load_kn, load_n, rpm), False
+
+
+def journal_bore(d: float) -> float:
+    """The bore the bearings of a shaft of ``d`` have: ``d``, or (off the catalogue) the largest
+    bore below it (the journals turned down to it), else the smallest bore."""
+    from cadgen.machine.catalogue import preferred_diameters
+
+    bores = preferred_diameters()
+    if d in bores:
+        return d
+    below = [b for b in bores if b <= d]
+    return below[-1] if below else bores[0]

@@ -26,9 +26,10 @@ from dataclasses import dataclass
 from kinematics.errors import Problem
 
 from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, planting_modules
-from cadgen.machine.bearings import select_bearing
+from cadgen.machine.bearings import journal_bore, select_bearing
 from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
 from cadgen.machine.fits import process_fits
+from cadgen.machine.fastening import coupling_key, flange_problems, free_bearing
 from cadgen.machine.layouts import (HOLLOW_WALL_MIN, _mount_fields, carry_flange, planting_axes,
                                     pricking_axes)
 from cadgen.machine.model import BearingSeat, Drivetrain, GearMount, HousingStack, Shaft
@@ -87,16 +88,6 @@ def _cam_bore_problems(params, shafts) -> list:
 
 
 # ------------------------------------------------------------------ sizing
-def _journal_bore(d: float) -> float:
-    """The bore the bearings of a shaft of ``d`` have: ``d``, or (off the catalogue) the largest
-    bore below it (the journals turned down to it), else the smallest bore."""
-    bores = preferred_diameters()
-    if d in bores:
-        return d
-    below = [b for b in bores if b <= d]
-    return below[-1] if below else bores[0]
-
-
 def _span(axis, cavities, base, widths) -> tuple:
     """Heights (mm, from the axis housing's cavity floor) of its two bearings' centres."""
     h = axis.housing
@@ -161,7 +152,7 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
             d = next((b for b in preferred_diameters()
                       if b >= strong and _keys_hold(axis, b, machine)), strong)
     reactions = tuple(abs(v) for v in beam_reactions(z1, z2, loads))
-    bore_j = _journal_bore(d)
+    bore_j = journal_bore(d)
     if axis.roof_pair:   # a pair is two of one bearing: chosen for the larger reaction
         pick = select_bearing(bore_j, max(reactions), axis.loads.speed_rpm,
                               machine.bearing_life_min_h, min_width=max(widths))
@@ -250,26 +241,6 @@ def _core(d: float) -> float:
         return d
 
 
-def _free_bearing(axis, gear, face, d, machine, report):
-    """The bearing a free gear runs on (two side by side in its hub), its life and problems."""
-    load = axis.loads.gears[gear]
-    speed = axis.loads.free_speeds.get(gear, 0.0) if hasattr(axis.loads, "free_speeds") else 0.0
-    bearing, life, passed = select_bearing(_journal_bore(d), load.radial_n / 2, speed,
-                                           machine.bearing_life_min_h)
-    problems = []
-    if report and 2 * bearing.width > face + 1e-9:
-        problems.append(Problem("gears.face_width", "free_gear_too_narrow",
-                                f"the {gear} gear runs free on shaft {axis.name} on two "
-                                f"{bearing.designation} bearings ({2 * bearing.width:g} mm side by "
-                                f"side), wider than its {face:g} mm face: widen gears.face_width"))
-    if report and not passed:
-        problems.append(Problem("machine.bearing_life_min_h", "bearing_life_short",
-                                f"the {gear} gear's bearings {bearing.designation} on shaft "
-                                f"{axis.name}: L10h {life:.0f} h is below "
-                                f"{machine.bearing_life_min_h:g} h"))
-    return bearing, speed, life, problems
-
-
 def _mounts(axis, d, fits, machine, report: bool, base=None) -> tuple:
     mounts, problems = [], []
     for mount_tuple in axis.mounts:
@@ -280,7 +251,7 @@ def _mounts(axis, d, fits, machine, report: bool, base=None) -> tuple:
         torque = load.torque_nmm
         key, flat = None, 0.0
         if free:
-            bearing, speed, life, found = _free_bearing(axis, gear, face, d, machine, report)
+            bearing, speed, life, found = free_bearing(axis, gear, face, d, machine, report)
             problems += found
             mounts.append(GearMount(gear, z, face, 0.0, load.radial_n, bearing.outside, None, 0.0,
                                     fits.seat_allowance(bearing.outside), housing or "",
@@ -311,52 +282,6 @@ def _mounts(axis, d, fits, machine, report: bool, base=None) -> tuple:
         mounts.append(GearMount(gear, z, face, torque / 1000.0, load.radial_n, d, key, flat,
                                 fits.hub_allowance(d), housing or ""))
     return tuple(mounts), problems
-
-
-def _flange_problems(axis, d, torque_nmm, flange) -> list:
-    """A carrying flange's screws in shear: ``tau = T / (n A_s r)`` against 0.3 x 640 MPa (8.8,
-    a third of the yield's shear with the service factor already in T)."""
-    from cadgen.machine.catalogue import socket_screw
-
-    # ISO 898-1's stress area: pi / 4 ((d2 + d3) / 2)^2, d2 = d - 0.6495 P, d3 = d - 1.2269 P
-    bolt, pitch = float(flange["bolt"].removeprefix("M")), socket_screw(flange["bolt"])["pitch"]
-    area = math.pi / 4 * ((2 * bolt - 1.8764 * pitch) / 2) ** 2
-    flange["stress_area_mm2"] = area
-    stress = torque_nmm / (flange["bolts"] * area * flange["bolt_circle_radius"])
-    flange["bolt_shear_mpa"] = stress
-    flange["bolt_shear_allow_mpa"] = FLANGE_SHEAR_ALLOW
-    if stress <= FLANGE_SHEAR_ALLOW:
-        return []
-    return [Problem("machine.shafts", "flange_bolts_overloaded",
-                    f"the flange of shaft {axis.name} ({flange['bolts']} x {flange['bolt']}) "
-                    f"carrying {axis.carries} shears its screws at {stress:.0f} MPa, above "
-                    f"{FLANGE_SHEAR_ALLOW:g} MPa")]
-
-
-def _coupling_key(axis, d: float, stub: float, machine, report: bool) -> tuple:
-    """The DIN 6885 key of a shaft's stub (the sprocket's or coupling's hub is the stub less a
-    chamfer each end, ``STUB_CHAMFER``), and its flank pressure under the shaft's torque."""
-    try:
-        key = hub_key(d, stub - 2 * STUB_CHAMFER)
-    except CatalogueError as error:
-        return None, ([Problem(f"machine.shafts.{axis.name}", "coupling_without_key",
-                               f"the {d:g} mm stub of shaft {axis.name} takes no key: {error}")]
-                      if report else [])
-    if key is None or not report:
-        return key, []
-    pressure = key_pressure(axis.loads.torque_nmm, d, key)
-    if pressure <= machine.key_pressure_mpa:
-        return key, []
-    return key, [Problem(f"machine.shafts.{axis.name}", "key_overloaded",
-                         f"the coupling key of shaft {axis.name} ({key.designation}) carries "
-                         f"{axis.loads.torque_nmm / 1000:.1f} N m at {pressure:.0f} MPa, above "
-                         f"machine.key_pressure_mpa = {machine.key_pressure_mpa:g} MPa")]
-
-
-#: The stub's chamfer at each end of a coupling's hub (mm): the key is no longer than the rest.
-STUB_CHAMFER = 2.0
-#: The carrying flange's screws (8.8): allowed shear stress, MPa.
-FLANGE_SHEAR_ALLOW = 190.0
 
 
 #: Rounds of drive redesign round its shafts' hubs (each can only grow the gears).
@@ -404,7 +329,7 @@ def _shaft_problems(axis, sized, given, machine, both_sides) -> list:
                                 f"shaft {axis.name}{sides}: no catalogue bearing has a {d:g} mm "
                                 f"bore (bores: {', '.join(f'{b:g}' for b in preferred_diameters())}"
                                 f"); its journals would be turned down to "
-                                f"{_journal_bore(d):g} mm"))
+                                f"{journal_bore(d):g} mm"))
     if given is None and core < sized.required - 1e-9:
         problems.append(Problem("machine.tip_load_n", "shaft_beyond_catalogue",
                                 f"shaft {axis.name}{sides} needs {sized.required:.1f} mm, more "
@@ -507,10 +432,10 @@ def drivetrain(params, design) -> Drivetrain:
             flange = carry_flange(d)
             flange["carries"] = axis.carries
             if report:
-                problems += _flange_problems(axis, d, axis.loads.torque_nmm, flange)
+                problems += flange_problems(axis, d, axis.loads.torque_nmm, flange)
         coupling = None
         if axis.floor_through and axis.below(d) > 0:   # a stub for a sprocket or coupling
-            coupling, found = _coupling_key(axis, d, float(axis.below(d)), machine, report)
+            coupling, found = coupling_key(axis, d, float(axis.below(d)), machine, report)
             problems += found
         shafts.append(Shaft(axis.name, axis.housing, axis.side, axis.xy, d, size.required,
                             axis.name in given, axis.loads.torque_nmm / 1000.0, size.bending,

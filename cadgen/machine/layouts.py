@@ -101,7 +101,7 @@ def planting_bases(cavities, gap: float):
 
 
 def planting_axes(params, mechanism, drive=None) -> tuple:
-    from cadgen.gears.circular import holding_set_module, planting_drive
+    from cadgen.gears.circular import holding_set_module, planting_drive, train1_set_radii
     from kinematics.errors import DesignError
 
     housing, gears = params.housing, params.gears
@@ -113,6 +113,7 @@ def planting_axes(params, mechanism, drive=None) -> tuple:
     except DesignError:   # the teeth stage refuses the set and says why; size as set II's
         module_i = module_c
     face_nc, face_c = gears.face_width_for(module_nc), gears.face_width_for(module_c)
+    set_one, set_two = train1_set_radii(mechanism, "I"), train1_set_radii(mechanism, "II")
     face_i = gears.face_width_for(module_i)
     if drive is None:   # the drivetrain redesigns it round its shafts' hubs when they grow
         drive = planting_drive(mechanism, module_c, gears.circular_module,
@@ -173,11 +174,17 @@ def planting_axes(params, mechanism, drive=None) -> tuple:
     for side, sign in ((1, 1.0), (2, -1.0)):
         xy = {axis: (sign * radii[axis] * line[0], sign * radii[axis] * line[1])
               for axis in ("A", "B", "C")}
-        for axis, keyed, free in (("A", "idler 1", "idler 1-I"), ("B", "idler 2", "idler 2-I")):
-            axes.append(_Axis(axis, "gearbox1", side, xy[axis], loads[axis],
-                              ((free, gap, face_i, None, True), (keyed, layer1_2, face_c)),
+        for axis, two, one in (("A", "idler 1", "idler 1-I"), ("B", "idler 2", "idler 2-I")):
+            # the two idlers of an axis turn at different speeds: one is keyed to the shaft,
+            # the other runs free on two bearings in its hub, the one with more room under
+            # its root circle for them
+            index = "AB".index(axis) + 1
+            free_one = (set_one[index] - 1.25 * module_i) >= (set_two[index] - 1.25 * module_c)
+            mounts = ((one, gap, face_i, None, free_one), (two, layer1_2, face_c, None, not free_one))
+            keyed, free = (two, one) if free_one else (one, two)
+            axes.append(_Axis(axis, "gearbox1", side, xy[axis], loads[axis], mounts,
                               False, False, none, 0.0, None,
-                              f"{keyed} keyed; {free} (set I) runs free on two bearings"))
+                              f"{keyed} keyed; {free} runs free on two bearings"))
         axes.append(_Axis("C2", "gearbox1", side, xy["C"], loads["C2"],
                           (("planet I", gap, face_i),
                            ("central", gap, face_nc, "gearbox2", False)),

@@ -87,8 +87,8 @@ def planting_speeds(mechanism, carrier_rpm: float, drive=None) -> dict:
 
 
 def free_speeds(mechanism, carrier_rpm: float) -> dict:
-    """Speeds (r/min) of set I's idlers relative to the shafts A and B they run free on
-    (the set-II idlers, keyed): ``(n - 1) omega |r_s1 / r_1 - r_s2 / r_2|``."""
+    """Speeds (r/min) of each axis's two idlers relative to each other (one keyed to the shaft,
+    the other free on it): ``(n - 1) omega |r_s1 / r_1 - r_s2 / r_2|``."""
     from cadgen.gears.circular import train1_set_radii
 
     relative = (mechanism.n - 1.0) * float(carrier_rpm)
@@ -162,10 +162,12 @@ def planting_loads(mechanism, machine, pressure_angle: float, carrier_rpm: float
                                   "sun I": load("sun I", T_sun1, Ft_1)}, speeds["O"]),
         "A": FreeAxisLoads("A", 0.0, {"idler 1": load("idler 1", 0.0, Ft_2, meshes=2),
                                       "idler 1-I": load("idler 1-I", 0.0, Ft_1, meshes=2)},
-                           speeds["A"], free_speeds={"idler 1-I": frees["idler 1-I"]}),
+                           speeds["A"], free_speeds={"idler 1-I": frees["idler 1-I"],
+                                                     "idler 1": frees["idler 1-I"]}),
         "B": FreeAxisLoads("B", 0.0, {"idler 2": load("idler 2", 0.0, Ft_2, meshes=2),
                                       "idler 2-I": load("idler 2-I", 0.0, Ft_1, meshes=2)},
-                           speeds["B"], free_speeds={"idler 2-I": frees["idler 2-I"]}),
+                           speeds["B"], free_speeds={"idler 2-I": frees["idler 2-I"],
+                                                     "idler 2": frees["idler 2-I"]}),
         "C": AxisLoads("C", T_C, {"train-1 planet": load("train-1 planet", T_C, Ft_2)},
                        speeds["C"], external=("roof", F)),
         "C2": AxisLoads("C2", T_C2, {"planet I": load("planet I", T_C2, Ft_1),
