@@ -230,4 +230,4 @@ def test_each_keyseat_lies_under_its_gears_keyway_at_every_pose(built):
                 gap = (turn_shaft + _direction(seat)) - (turn_gear + _direction(keyway))
                 assert abs(math.remainder(gap, 2 * math.pi)) < 1e-9, (shaft.name, mount.gear, phi)
             checked += 1
-X
+    assert checked == 16 - 2     # every keyed gear (one idler on each of A and B runs free)
