@@ -121,3 +121,83 @@ def test_motion_read_from_the_placements(paper, train):
             za = teeth[{"sun": "sun", "idler-1": "idler 1", "sun-I": "sun I",
                         "idler-2-I": "idler 2-I"}[drive]]
             assert wrap(a * za + b * zb) == pytest.approx(0.0, abs=1e-6)
+
+
+# ------------------------------------------------------------------ the pricking mechanism
+@pytest.fixture(scope="module")
+def kernel_b():
+    from cadgen.design import pricking_design
+    from cadgen.machine.drivetrain import drivetrain
+
+    params = load_params("params/kernel-b.toml")
+    return params, drivetrain(params, pricking_design(params))
+
+
+def test_the_pricking_sun_is_held_and_its_case_driven(kernel_b):
+    params, machine = kernel_b
+    held = machine.rules["case_drive"]
+    sprocket = held["sprocket"]
+    # ISO 606 08B-1 (p = 12.7 mm): a 19-tooth wheel's pitch diameter is 77.16 mm in the
+    # sprocket tables (p / sin(180 deg / z)); its root, pitch less the 8.51 mm roller
+    assert sprocket["teeth"] == 19
+    assert sprocket["pitch_diameter"] == pytest.approx(77.16, abs=0.005)
+    assert sprocket["root_diameter"] == pytest.approx(77.16 - 8.51, abs=0.005)
+    # the screws' circle clears the bore and the root by 1.5 screw diameters; 18 teeth would not
+    assert sprocket["root_diameter"] / 2 >= sprocket["bolt_circle_radius"] + 7.5
+    assert 12.7 / math.sin(math.pi / 18) / 2 - 8.51 / 2 < sprocket["bolt_circle_radius"] + 7.5
+    # the chain's pull times the pitch radius is the case's torque
+    assert sprocket["chain_pull_n"] * sprocket["pitch_diameter"] / 2 == pytest.approx(
+        sprocket["torque_nm"] * 1000.0)
+    sun = next(s for s in machine.shafts if s.name == "sun")
+    assert sun.coupling_key is not None and sun.coupling_key.length <= sun.extends_below - 4
+
+
+def test_the_pricking_joint_graph_by_hand(kernel_b):
+    from cadgen.assembly.machine import pricking_model
+
+    _, machine = kernel_b
+    model = pricking_model(machine, [("sun", "intermediate 1"), ("intermediate 2", "planet")])
+    # bodies: the frame (bracket, sun shaft, sun gear), the case (base, cover, sprocket), the
+    # intermediate shaft and gears, the planet shaft, gear, rocker and needle: N = 4; three
+    # revolutes, two meshes: M = 3 x 3 - 2 x 3 - 2 = 1
+    report = model.mobility_report()
+    assert (report["bodies"], report["lower_pairs"], report["higher_pairs"]) == (4, 3, 2)
+    assert model.mobility() == 1 and model.unconnected() == []
+    # without the stub's key nothing holds the mechanism to the frame
+    key = next(j for j in model.joints if j.a == "shaft-sun" and j.b == "frame-bracket")
+    assert "DIN 6885" in key.detail
+    assert set(model.without(key).unconnected()) == set(model.parts) - {"frame-bracket"}
+
+
+@settings(max_examples=60, deadline=None)
+@given(R=st.floats(25, 60), i12=st.floats(0.8, 1.8), i13=st.floats(0.8, 1.8),
+       n=st.sampled_from([3.0, 2.5, 4.0, 5.0]))
+def test_set_i_meets_its_axes_standard_or_shifted(R, i12, i13, n):
+    """Any base radius: set I is standard where whole teeth fit, else profile-shifted; either
+    way each mesh's working centre distance, computed back from the teeth, module and shifts
+    (ISO 21771's inverse, Newton), is its axis distance to 0.01 mm, the sun-to-planet ratio is
+    exactly 1/(n - 1), and no gear is undercut by a rack (x >= 1 - z sin^2(alpha) / 2)."""
+    from fractions import Fraction
+
+    from cadgen.gears.circular import TrainAxes, holding_set_design
+    from cadgen.gears.trains import working_centre_distance
+    from kinematics.errors import DesignError
+
+    alpha = math.radians(20.0)
+    try:
+        design = holding_set_design(TrainAxes(R, i12, i13, n), None, alpha)
+    except DesignError as error:   # refused: it names the field and the reason
+        assert error.problems[0].path.startswith("train.")
+        return
+    z = design.teeth
+    assert Fraction(z[0], z[3]) == Fraction(1.0 / (n - 1.0)).limit_denominator(50)
+    radii = train1_set_radii(TrainAxes(R, i12, i13, n), "I")
+    axes = (radii[0] + radii[1], radii[1] + radii[2], radii[2] + radii[3])
+    for k in range(3):
+        a_w = working_centre_distance(z[k], z[k + 1], design.module,
+                                      design.shifts[k] + design.shifts[k + 1], alpha)
+        assert abs(a_w - axes[k]) < 0.01
+    if design.shifted:
+        assert all(x >= 1 - teeth * math.sin(alpha) ** 2 / 2 - 1e-9
+                   for x, teeth in zip(design.shifts, z)), (z, design.shifts)
+        assert max(abs(x) for x in design.shifts) <= 0.5

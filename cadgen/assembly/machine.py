@@ -123,23 +123,29 @@ def planting_model(drivetrain, meshes=()) -> AssemblyModel:
 
 
 def pricking_model(drivetrain, meshes=()) -> AssemblyModel:
-    """The pricking machine's joint graph: the sun's shaft held by the frame, the gear case
-    turning on it (the input), the intermediate and planet shafts, the rocker on the planet."""
-    b = _Builder("frame")
+    """The pricking machine's joint graph: the frame bracket holding the sun's shaft by its
+    stub's key, the gear case turning on that shaft and driven by the sprocket bolted to it,
+    the intermediate and planet shafts in the case, the rocker and needle on the planet."""
+    held = drivetrain.rules.get("case_drive")
+    b = _Builder("frame-bracket")
     b.joint("fixed", "gear-case-cover", "gear-case-base", "flange bolts")
     gears = {}
     for shaft in drivetrain.shafts:
         me = f"shaft-{shaft.name}"
-        if shaft.name == "sun":
-            b.joint("fixed", me, "frame", "stub clamped in the frame: " + NOT_MADE[0])
+        if shaft.name == "sun":   # the sun does not turn: its shaft's stub keyed in the bracket
+            b.joint("fixed", me, "frame-bracket",
+                    shaft.coupling_key.designation if shaft.coupling_key is not None
+                    else "stub in the bracket: " + NOT_MADE[0] + " (key)")
         b.joint("revolute", me, "gear-case-base", _bearings(shaft))
         for mount in shaft.mounts:
             gear = _slug(mount.gear)
             gears[mount.gear] = gear
             b.joint("fixed", gear, me, mount.key.designation if mount.key is not None
                     else f"D-flat {mount.flat_depth:g} mm")
-    b.joint("revolute", "gear-case-base", "frame",
-            "the case turns about the sun's shaft (its floor bearing), driven from the input")
+    if held:
+        sprocket = held["sprocket"]
+        b.joint("fixed", "case-sprocket", "gear-case-base",
+                f"{sprocket['bolts']} x {sprocket['bolt']} screws (the chain drives it)")
     for drive, driven in meshes:
         if drive in gears and driven in gears:
             b.joint("gear", gears[drive], gears[driven], f"mesh {drive} - {driven}")

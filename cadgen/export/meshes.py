@@ -71,6 +71,9 @@ _UUID_NAMESPACE = uuid.uuid5(uuid.NAMESPACE_DNS, "cadgen.solids")
 GLTF_METRES_PER_MM = 1e-3
 #: Faces meeting at more than this angle (deg) get separate vertex normals (a sharp edge).
 CREASE_ANGLE_DEG = 30.0
+#: Part kinds bought, not made (the case's chain sprocket): placed in the assembly (GLB) as
+#: their envelope, listed in the bill from the drivetrain, never written as a file to make.
+BOUGHT_KINDS = frozenset({"sprocket"})
 #: A material per part kind: sRGB colour, opacity (below 1: alphaMode BLEND), metalness.
 #: Housing covers and the soil are see-through, so the gears inside them show; a housing's
 #: base is opaque (one looks into it through the cover). ``"housing-cover"`` is not a part
@@ -86,6 +89,7 @@ PART_MATERIALS = {
     "rocker": (0x3C7FB0, 1.0, 0.1),
     "needle": (0x3A3F47, 1.0, 0.3),
     "ground": (0x9B7653, 0.35, 0.0),
+    "sprocket": (0x4A4F57, 1.0, 0.6),   # a bought steel chain wheel (its envelope)
     "part": (0x8C8C8C, 1.0, 0.1),   # a part of no known kind
 }
 
@@ -453,6 +457,8 @@ def solids_files(outcome):
     """``(file name, bytes)`` of each file :func:`write_solids` writes, each made once per
     outcome (:meth:`~cadgen.solids.outcome.SolidsOutcome.once`), as it is asked for."""
     for part in outcome.assembly.parts:
+        if part.kind in BOUGHT_KINDS:   # a bought part: in the assembly, not a file to make
+            continue
         yield f"{part.name}.stl", outcome.once(("stl", part.name),
                                                lambda: stl_bytes(outcome.printing_mesh(part)))
 

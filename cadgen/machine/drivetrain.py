@@ -284,6 +284,29 @@ def _mounts(axis, d, fits, machine, report: bool, base=None) -> tuple:
     return tuple(mounts), problems
 
 
+def _pricking_case_drive(params, design, shafts, loads) -> tuple:
+    """The bracket holding the sun's stub and the sprocket driving the gear case
+    (:func:`cadgen.machine.case_drive.case_drive`), and its screws' check. The case's torque:
+    the moments about O on it, the sun's reaction and the tool's load at its largest reach,
+    ``T_case = T_sun + F (2 a + l)``."""
+    from cadgen.machine.case_drive import case_drive
+    from cadgen.machine.loads import design_load
+
+    sun = next(s for s in shafts if s.name == "sun")
+    if sun.coupling_key is None:
+        return None, []
+    link = design.linkage
+    torque = loads["sun"].torque_nmm + design_load(params.machine) * (2 * link.a + link.l)
+    held = case_drive(sun.diameter, sun.coupling_key.hub_depth, sun.extends_below, torque,
+                      params.field.carrier_speed_rpm, params.housing.axial_gap)
+    screws = dict(held["sprocket"])
+    found = flange_problems(type("Axis", (), {"name": "gear case", "carries": "its sprocket"}),
+                            sun.diameter, torque, screws)
+    held["sprocket"].update({k: screws[k] for k in ("stress_area_mm2", "bolt_shear_mpa",
+                                                    "bolt_shear_allow_mpa")})
+    return held, found
+
+
 #: Rounds of drive redesign round its shafts' hubs (each can only grow the gears).
 DRIVE_ROUNDS = 4
 
@@ -451,6 +474,10 @@ def drivetrain(params, design) -> Drivetrain:
                                 f"than the {DRIVE_SLEEVE_DIAMETER:g} mm the drive's driven gear "
                                 "was designed round"))
     problems += _cam_bore_problems(params, shafts)
+    held = None
+    if params.mechanism == "pricking":
+        held, found = _pricking_case_drive(params, design, shafts, loads)
+        problems += found
     if not converged:
         problems.append(Problem("machine", "drivetrain_not_settled",
                                 f"bearings and end walls still changed after {iterations} "
@@ -475,6 +502,8 @@ def drivetrain(params, design) -> Drivetrain:
     if drive is not None:
         rules["drive"] = drive.as_report()
         rules["stack_bases_mm"] = base
+    if held is not None:
+        rules["case_drive"] = held
     return Drivetrain(params.mechanism, tuple(shafts), stacks, fits.process, rules,
                       tuple(problems), drive, base)
 

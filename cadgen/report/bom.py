@@ -62,11 +62,15 @@ def _copies(assembly) -> dict:
 def _description(part: dict) -> str:
     """What a made part is: its kind's words; a housing half says which half and which
     segment (a printed housing too long for the bed is cut into bolted segments)."""
+    if part["part"] == "frame-bracket":
+        return "frame bracket (holds the sun's shaft; the transplanter's mounting holes)"
     if part["kind"] == "housing":
         match = re.search(r"-(base|cover)(?:-(\d+))?$", part["part"])
         if match:
             half, segment = match.groups()
-            return f"gearbox housing {half}" + (f", segment {segment}" if segment else "")
+            what = ("frame (transmission box)" if part["part"].startswith("frame-")
+                    else "gearbox housing")
+            return f"{what} {half}" + (f", segment {segment}" if segment else "")
     return _DESCRIPTIONS.get(part["kind"], part["kind"])
 
 
@@ -129,6 +133,22 @@ def _bought_rows(drivetrain, housings: dict, copies: dict, gears: set) -> list:
             item = f"ISO 4762 {thread} x {length:g} - 8.8"
             fasteners[item] += sides * int(flange["bolts"])
             describe[item] = ("socket head cap screw", item)
+    held = drivetrain.rules.get("case_drive")
+    if held:   # the pricking case's chain sprocket and its screws into the case's floor
+        sprocket = held["sprocket"]
+        item = (f"chain sprocket ISO 606 {held['chain']['designation']}, plate wheel, "
+                f"z = {sprocket['teeth']}, bored {sprocket['bore']:.1f} mm, "
+                f"{sprocket['bolts']} x {sprocket['bolt']} holes on a "
+                f"{2 * sprocket['bolt_circle_radius']:.1f} mm circle")
+        fasteners[item] += 1
+        describe[item] = ("sprocket", f"ISO 606 {held['chain']['designation']} z{sprocket['teeth']}")
+        from cadgen.machine.catalogue import screw_length
+
+        size = float(sprocket["bolt"].removeprefix("M"))
+        length = screw_length(sprocket["bolt"], sprocket["width"] + 1.5 * size)
+        screw = f"ISO 4762 {sprocket['bolt']} x {length:g} - 8.8"
+        fasteners[screw] += int(sprocket["bolts"])
+        describe[screw] = ("socket head cap screw", screw)
     for name, housing in housings.items():
         count = len(getattr(housing, "bolt_positions", ()))
         if not count:

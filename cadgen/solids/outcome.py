@@ -30,8 +30,9 @@ FACE_AREA_RTOL = 1e-6
 #: A part is turned about z onto its footprint's smallest box only when that box is
 #: smaller by more than this fraction: a round part (a gear, the cam) keeps its angle.
 FOOTPRINT_AREA_RTOL = 0.01
-#: Parts that are not made (the soil slab): not checked against the build volume.
-_NOT_MADE = frozenset({"ground"})
+#: Parts that are not made (the soil slab, a bought sprocket's envelope): not checked against
+#: the build volume, not in the bill's made parts.
+_NOT_MADE = frozenset({"ground", "sprocket"})
 
 
 @dataclass

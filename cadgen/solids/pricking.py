@@ -73,6 +73,7 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     from cadgen.solids.housings import ShellSize
     from dataclasses import replace
 
+    from cadgen.solids.case_drive import case_drive_parts, sprocket_tapped_holes
     from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
 
     if drivetrain is None:
@@ -158,16 +159,23 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
         discs = {0.0: link.a, round(link.a, 6): link.a, round(2 * link.a, 6): link.a}
     circles = [(*(centre + d * line), r) for d, r in sorted(discs.items())]
     height, floor, roof = stack.cavity_height, stack.floor_wall, stack.roof_wall
+    held = drivetrain.rules.get("case_drive")   # the bracket and the case's sprocket
+    tapped = sprocket_tapped_holes(held, centre, floor) if held else ()
     case = stack_housing(params, circles, ShellSize(clearance, wall, gap, module), stack,
                          drivetrain.seats("gear-case"), z_cavity_bottom=0.0, segments=segments,
-                         path="housing.gear-case")
+                         path="housing.gear-case", tapped=tapped)
     # cut into bolted segments when printed and too big for the printer (splices kept on it)
     case_parts, joints = printed_housing_parts("gear-case", case, "case", params)
     case = replace(case, joints=tuple(joints))
     parts[:0] = case_parts
     # the shafts turn with their gears, keyseats under the gears' keyways
-    parts += [shaft_part(shaft, case, "case", segments=segments, gears=frames)
+    shafts = [shaft_part(shaft, case, "case", segments=segments, gears=frames)
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
+    parts += shafts
+    if held:
+        sun = next(s for s in drivetrain.shafts if s.name == "sun")
+        sun_part = next(p for p in shafts if p.name == "shaft-sun")
+        parts += case_drive_parts(held, sun, sun_part, centre, floor, gap, segments)
     parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)
     if soil:
         reach = 2 * link.a + link.l + max(r for _, _, r in circles)
