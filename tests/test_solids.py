@@ -60,7 +60,8 @@ def test_every_part_is_a_closed_positive_volume(which, request):
         assert mesh.volume > 0, part.name
         kinds.add(part.kind)
     expected = ({"gear", "housing", "shaft", "cam", "planter", "blade", "ground"}
-                if which == "planting" else {"gear", "housing", "shaft", "rocker", "needle", "ground"})
+                if which == "planting" else {"gear", "housing", "shaft", "rocker", "needle", "ground",
+                                             "sprocket"})
     assert kinds == expected
 
 

@@ -31,6 +31,14 @@ def machine_checks(report: dict) -> list:
              "its flank pressure"),
             ("shafts", not other, f"{len(shafts)} shafts sized" if not other
              else "; ".join(p["message"] for p in other))]
+    assembly = machine.get("assembly")
+    if assembly:
+        rule = assembly["mobility_rule"]
+        rows.append(("joint graph", bool(assembly.get("passed")),
+                     f"mobility {assembly['mobility']} ({rule['bodies']} bodies, "
+                     f"{rule['lower_pairs']} revolute, {rule['higher_pairs']} gear and cam "
+                     "pairs)" + ("; loose: " + ", ".join(assembly["unconnected"])
+                                 if assembly["unconnected"] else "")))
     rims = machine.get("hubs", [])
     if rims:
         thin = [r for r in rims if not r["passed"]]
@@ -79,6 +87,8 @@ def machine_section_html(report: dict) -> str:
             f"{h['gear']}: " + (h["key"]["designation"].removeprefix("parallel key ")
                                 + f" ({_number(h['key'].get('pressure_mpa'), 0)} MPa)"
                                 if h.get("key") else
+                                f"runs free on 2 x {h['runs_free_on']['designation']}"
+                                if h.get("runs_free_on") else
                                 f"D-flat {_number(h.get('flat_depth_mm'))} mm"
                                 if h.get("flat_depth_mm") else "plain bore")
             for h in s.get("hubs", []))
@@ -93,8 +103,9 @@ def machine_section_html(report: dict) -> str:
         empty="no shafts sized"))
     rows, classes = [], []
     for b, side in _sides(machine.get("bearings", []), lambda r: (r["shaft"], r["wall"])):
-        rows.append([_e(f"{b['shaft']} {b['wall']}{side}"),
-                     _e(b["designation"]),
+        rows.append([_e(f"{b['shaft']} {b['housing']} {b['wall']}{side}"),
+                     _e(b["designation"] + (f" x {b['count']} (pair)"
+                                            if b.get("count", 1) > 1 else "")),
                      _e(f"{_number(b['d_mm'], trim=True)} x {_number(b['D_mm'], trim=True)} x "
                         f"{_number(b['B_mm'], trim=True)}"),
                      _e(_number(b["C_kn"], trim=True)), _e(_number(b["seat_diameter_mm"], 4)),
@@ -114,6 +125,8 @@ def machine_section_html(report: dict) -> str:
         body.append("<h3>Rim left under each gear's bore and keyway</h3>" + _table(
             ["gear", "thinnest rim (mm)", "fails below (mm)", "warns below (mm)", "check"],
             rows, numeric=(1, 2, 3)))
+    body.append(_transmission_html(report))
+    body.append(_joint_graph_html(machine.get("assembly")))
     problems = machine.get("problems", [])
     if problems:
         body.append(_problem_list(problems))
@@ -122,7 +135,73 @@ def machine_section_html(report: dict) -> str:
         body.append("<details><summary>how the sizes were chosen</summary><ul>"
                     + "".join(f"<li><b>{_e(k.replace('_', ' '))}</b>: {_e(v)}</li>"
                               for k, v in rules.items()) + "</ul></details>")
-    return _section("machine", "Shafts, bearings and hubs", "".join(body))
+    return _section("machine", "Transmission: shafts, bearings, hubs, joints", "".join(body))
+
+
+def _transmission_html(report: dict) -> str:
+    """Train 1's two sets mesh by mesh (working against axis distance), the frame's drive, the
+    pricking case's hold and drive."""
+    train = report.get("gear_train") or {}
+    out = []
+    rows = []
+    for record in train.get("sets", []):
+        for mesh in record["meshes"]:
+            rows.append([_e(record["name"]), _e(f"{mesh['driver']} → {mesh['driven']}"),
+                         _e(f"{mesh['driver_teeth']} / {mesh['driven_teeth']}"),
+                         _e(_number(mesh["module_mm"], trim=True)),
+                         _e(" / ".join(_number(x, 3) for x in mesh.get("profile_shifts", []))),
+                         _e(_number(mesh["centre_distance_mm"], 3)),
+                         _e(_number(mesh["axis_distance_mm"], 3))])
+    if rows:
+        ratios = "; ".join(f"{r['name']}: converted ratio {_number(r['converted_ratio'], 4)} "
+                           f"({'exact' if r['ratio_exact'] else 'not exact'} from the teeth)"
+                           for r in train["sets"])
+        out.append("<h3>Train 1: both sets on the axes O, A, B, C</h3><p>" + _e(ratios) + "</p>"
+                   + _table(["set", "mesh", "teeth", "module (mm)", "profile shifts",
+                             "working centre distance (mm)", "axis distance (mm)"], rows,
+                            numeric=(3, 5, 6)))
+    drive = train.get("drive")
+    if drive:
+        teeth = drive["teeth"]
+        out.append("<h3>The frame's drive</h3><p>" + _e(
+            f"input gear 1 ({teeth['z1']} teeth) → central shaft gear ({teeth['z2']}), input "
+            f"gear 2 ({teeth['z3']}) → transmission driven gear ({teeth['z4']}) on gearbox 1, "
+            f"module {_number(drive['module_1'], trim=True)} mm, axis distance "
+            f"{_number(drive['centre_distance'], trim=True)} mm: n = {drive['ratio_fraction']} "
+            f"({'exact' if drive['exact'] else 'error ' + _number(drive['ratio_error'], 6)}); "
+            f"the input turns at {_number(drive['input_speed_rpm'], 1)} r/min for "
+            f"{_number(drive['carrier_speed_rpm'], 1)} r/min of carrier 1") + "</p>")
+    held = ((report.get("machine") or {}).get("rules") or {}).get("case_drive")
+    if held:
+        sprocket, bracket = held["sprocket"], held["bracket"]
+        out.append("<h3>The gear case's hold and drive</h3><p>" + _e(
+            f"the sun's shaft is keyed into a frame bracket ({_number(bracket['plate'], 1)} mm "
+            f"plate, 4 x {bracket['mount_bolt']} mounting holes); the case is driven by an ISO "
+            f"606 {held['chain']['designation']} sprocket of {sprocket['teeth']} teeth "
+            f"(pitch diameter {_number(sprocket['pitch_diameter'], 2)} mm) bolted to its floor: "
+            f"{_number(sprocket['torque_nm'], 1)} N·m at {_number(sprocket['speed_rpm'], 1)} "
+            f"r/min, a chain pull of {_number(sprocket['chain_pull_n'], 0)} N") + "</p>")
+    return "".join(out)
+
+
+def _joint_graph_html(assembly) -> str:
+    """The joint graph's verdict: bodies, pairs, mobility, loose parts, joints not yet made."""
+    if not assembly:
+        return ""
+    rule = assembly["mobility_rule"]
+    text = (f"{len(assembly['parts'])} parts, {len(assembly['joints'])} joints: "
+            f"{rule['bodies']} rigid bodies, {rule['lower_pairs']} revolute joints, "
+            f"{rule['higher_pairs']} gear and cam pairs; {rule['formula']} = "
+            f"{assembly['mobility']}")
+    loose = assembly.get("unconnected") or []
+    body = ("<h3>Joint graph</h3><p>" + _pass_badge(assembly.get("passed")) + " " + _e(text)
+            + (_e("; held by nothing: " + ", ".join(loose)) if loose else "") + "</p>")
+    not_made = assembly.get("not_made") or []
+    if not_made:
+        body += ("<details><summary>joints in the graph not yet made as parts "
+                 f"({len(not_made)})</summary><ul>"
+                 + "".join(f"<li>{_e(item)}</li>" for item in not_made) + "</ul></details>")
+    return body
 
 
 def bom_section_html(report: dict) -> str:

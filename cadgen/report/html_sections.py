@@ -222,6 +222,8 @@ def _sweep_section(report: dict) -> str:
     rows = [[_e(label)] + [cell(sweeps[n]) for n in names] for label, cell in fields]
     headers = ["", *(_sweep_name(n, sweeps[n]) for n in names)]
     body = _table(headers, rows)
+    notes = [sweeps[n]["frame_note"] for n in names if sweeps[n].get("frame_note")]
+    body += "".join(f"<p>{_e(note[:1].upper() + note[1:])}.</p>" for note in notes)
     return _section("sweep", "Interference and clearance sweep", body)
 
 

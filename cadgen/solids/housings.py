@@ -114,7 +114,7 @@ def envelope_circles(mechanism: PlantingMechanism, module: float, allowance: flo
     closure = mechanism.closure
     a = closure.centre_distance
     r_min, r_max = closure.radius_min[1], closure.radius_max[1]
-    R, r = mechanism.R, mechanism.r
+    r = mechanism.r
     m_c = module if circular_module is None else circular_module
     outer1 = allowance if gearbox1_allowance is None else gearbox1_allowance
     shifts = shifts or {}
