@@ -302,7 +302,7 @@ def _draw_plan(ax, housing, *, turned=False, line=None, scale=None) -> dict:
         return (points[:, 1], points[:, 0]) if turned else (points[:, 0], points[:, 1])
 
     up = -1.0 if turned else 1.0      # the sign of "up the page" in the vertical data axis
-    drawn = {"bolt_holes": [], "seats": [], "through_holes": [], "labels": []}
+    drawn = {"bolt_holes": [], "seats": [], "through_holes": [], "labels": [], "tapped": []}
     _fill(ax, *view(housing.flange_outline), facecolor=_FLANGE, edgecolor="k", linewidth=0.7,
           label="flange (plan)")
     _fill(ax, *view(housing.outer_outline), facecolor=_OUTER, edgecolor="k", linewidth=0.8,
@@ -327,6 +327,13 @@ def _draw_plan(ax, housing, *, turned=False, line=None, scale=None) -> dict:
         drawn["through_holes"].append(_circle(
             ax, (h, v), float(diameter) / 2, facecolor=_HOLE, edgecolor="k", linewidth=0.6,
             zorder=4, label=None if drawn["through_holes"] else "through hole (shaft leaves)"))
+    for x, y, diameter, depth, wall in getattr(housing, "tapped", ()):
+        # tapped from the wall's outer face (a carrying flange's screws, the mounting holes)
+        h, v = (float(c[0]) for c in view((x, y)))
+        drawn["tapped"].append(_circle(
+            ax, (h, v), float(diameter) / 2, facecolor="white", edgecolor="k", linewidth=0.6,
+            linestyle="--", zorder=4,
+            label=None if drawn["tapped"] else f"tapped hole in the {wall} (drill shown)"))
     for position, seats in groups.items():
         h, v = (float(c[0]) for c in view(position))
         for seat in seats:
