@@ -302,13 +302,8 @@ def holding_set_design(mechanism, requested=None, pressure_angle: float = math.r
 
     radii = train1_set_radii(mechanism, "I")
     distances = (radii[0] + radii[1], radii[1] + radii[2], radii[2] + radii[3])
-    try:
-        module = _standard_holding_module(mechanism, requested)
-    except DesignError as error:
-        if min(radii) <= 0.0:
-            raise
-        refusal = error
-    else:
+    module = _standard_holding_module(mechanism, requested)
+    if module is not None:
         teeth = tuple(int(round(2 * r / module)) for r in radii)
         return SetDesign(module, teeth, (0.0,) * 4, tuple(module * z / 2 for z in teeth),
                          distances, False, "standard gears: whole teeth at the axis distances")
@@ -319,7 +314,8 @@ def holding_set_design(mechanism, requested=None, pressure_angle: float = math.r
             f"train 1's set I must turn its planet at exactly -1/(n - 1) = "
             f"{-1.0 / (mechanism.n - 1.0):.6g} of the sun (relative to the carrier) to hold the "
             f"central gear still; no whole tooth counts up to 50 give it: choose n a ratio of "
-            f"small whole numbers (3, 2.5, 4, ...). {refusal.problems[0].message}")
+            f"small whole numbers (3, 2.5, 4, ...). "
+            f"{_no_standard_module(mechanism, radii).problems[0].message}")
     modules = ([float(requested)] if requested is not None
                else [round(step * 0.05, 10) for step in range(100, 9, -1)])
     chosen = None
@@ -339,7 +335,9 @@ def holding_set_design(mechanism, requested=None, pressure_angle: float = math.r
                          "sun-to-planet ratio exact, each mesh's shift sum from its axis distance "
                          "(ISO 21771), the free choice keeping every gear clear of undercut, "
                          "tips shortened to the standard clearance", pressure_angle)
-    raise refusal
+    # the refusal (its hint searches nearby base radii) is built only when it is raised: the
+    # optimiser's screen asks for many designs that the shifts solve
+    raise _no_standard_module(mechanism, radii, shifted_too=True)
 
 
 def holding_set_module(mechanism, requested=None,
@@ -348,14 +346,14 @@ def holding_set_module(mechanism, requested=None,
     return holding_set_design(mechanism, requested, pressure_angle).module
 
 
-def _standard_holding_module(mechanism, requested=None) -> float:
-    """The module of train 1's set I (its planet holds the central gear still), mm.
+def _standard_holding_module(mechanism, requested=None) -> float | None:
+    """The module of train 1's set I (its planet holds the central gear still) with standard
+    gears, mm, or None when no module gives whole teeth.
 
     ``requested`` (the file's ``gears.circular_module``) when it gives the set whole tooth
     counts, else the largest 0.05-mm step giving each of its gears whole teeth (at least
     ``MIN_CIRCULAR_TEETH``), so each mesh's centre distance is its axis distance with
-    standard gears. A set whose idler on B would have no radius, or that no module fits, is
-    refused (``DesignError``) with the reason and the nearest base radii that work.
+    standard gears. A set whose idler on B would have no radius is refused (``DesignError``).
     """
     radii = train1_set_radii(mechanism, "I")
     if min(radii) <= 0.0:
@@ -367,15 +365,21 @@ def _standard_holding_module(mechanism, requested=None) -> float:
             f"above {1.0 - 2.0 / mechanism.n:.3g} or lower train.n")
     if requested is not None and _whole(radii, requested, MIN_CIRCULAR_TEETH):
         return float(requested)
-    module = _auto_module(radii)
-    if module is not None:
-        return module
+    return _auto_module(radii)
+
+
+def _no_standard_module(mechanism, radii, shifted_too: bool = False) -> DesignError:
+    """The refusal of a set I no standard module fits (and, ``shifted_too``, no shifted one),
+    with the nearest base radii that need no shift."""
     hint = _radius_hint(mechanism, key="I")
-    raise DesignError.single(
+    shifted = (f"; nor do profile-shifted gears within |x| <= {SHIFT_LIMIT:g}"
+               if shifted_too else "")
+    return DesignError.single(
         "train.R", "fractional_teeth",
         f"no module from 0.5 to 5 mm (0.05-mm steps, at least {MIN_CIRCULAR_TEETH} teeth) gives "
         f"whole tooth counts for train 1's set I (radii {', '.join(f'{r:.4g}' for r in radii)} "
-        "mm, whose meshes must meet the axis distances of set II)" + (f"; {hint}" if hint else ""))
+        "mm, whose meshes must meet the axis distances of set II)" + shifted
+        + (f"; {hint}" if hint else ""))
 
 
 def planting_modules(mechanism, teeth: int, requested=None) -> tuple:

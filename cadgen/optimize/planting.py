@@ -153,14 +153,21 @@ class HousingRule:
         keys = ("sun_I", "idler_1_I", "idler_2_I", "planet_I")
         out = np.zeros((len(rows), 4))
         R, i12, i13 = (self.columns[k][rows] for k in ("R", "i12", "i13"))
+        done = {}   # rows with the same train (R, i12, i13 not searched) share one answer
         for row, axes in enumerate(zip(R, i12, i13)):
-            try:
-                design = holding_set_design(TrainAxes(*(float(v) for v in axes), self.n),
-                                            self.requested, self.pressure_angle)
-            except DesignError:
-                continue
-            out[row] = [radius + design.module * (1.0 + max(shift, self.shifts.get(key, 0.0), 0.0))
-                        for radius, shift, key in zip(design.reference_radii, design.shifts, keys)]
+            axes = tuple(float(v) for v in axes)
+            if axes not in done:
+                try:
+                    design = holding_set_design(TrainAxes(*axes, self.n), self.requested,
+                                                self.pressure_angle)
+                except DesignError:
+                    done[axes] = 0.0
+                else:
+                    done[axes] = [radius + design.module * (
+                        1.0 + max(shift, self.shifts.get(key, 0.0), 0.0))
+                        for radius, shift, key in zip(design.reference_radii, design.shifts,
+                                                      keys)]
+            out[row] = done[axes]
         return out
 
     def _envelope(self, module, rows, field: str, low: float, factor: float):
