@@ -59,7 +59,6 @@ def planting_model(drivetrain, meshes=()) -> AssemblyModel:
     b.joint("fixed", "gearbox1-cover", "gearbox1-base", "flange bolts")
     for arm in (1, 2):
         b.joint("fixed", f"gearbox2-cover-arm{arm}", f"gearbox2-base-arm{arm}", "flange bolts")
-    both = {s.name for s in drivetrain.shafts if s.side == 2}
 
     def housing_part(housing, side):
         return {"frame": "frame-base", "gearbox1": "gearbox1-base"}.get(
@@ -118,7 +117,6 @@ def planting_model(drivetrain, meshes=()) -> AssemblyModel:
                     "hinge: " + NOT_MADE[0] + " (pin)")
             b.joint("cam", f"{blade}-arm{arm}", f"cam-arm{arm}",
                     "opened by the cam through the duckbill linkage: " + NOT_MADE[0])
-    del both
     return b.model()
 
 

@@ -66,7 +66,7 @@ def case_drive(sun_diameter: float, hub_depth: float, stub: float, case_torque_n
         "chain": dict(CHAIN),
         "sprocket": {**sprocket, "bore": bore, "width": CHAIN["sprocket_width"],
                      "bolt": SPROCKET_BOLT, "bolts": SPROCKET_BOLTS,
-                     "bolt_circle_radius": bolt_circle, "speed_rpm": float(carrier_rpm),
+                     "bolt_circle_radius": bolt_circle, "bolt_phase": math.pi / 4, "speed_rpm": float(carrier_rpm),
                      "torque_nm": case_torque_nmm / 1000.0, "chain_pull_n": chain_pull},
         "bracket": {"boss_diameter": boss, "boss_length": stub - BRACKET_PLATE["thickness"]
                     - gap, "plate": plate, "plate_thickness": BRACKET_PLATE["thickness"],

@@ -300,8 +300,7 @@ def _pricking_case_drive(params, design, shafts, loads) -> tuple:
     held = case_drive(sun.diameter, sun.coupling_key.hub_depth, sun.extends_below, torque,
                       params.field.carrier_speed_rpm, params.housing.axial_gap)
     screws = dict(held["sprocket"])
-    found = flange_problems(type("Axis", (), {"name": "gear case", "carries": "its sprocket"}),
-                            sun.diameter, torque, screws)
+    found = flange_problems("the gear case", "its sprocket", torque, screws)
     held["sprocket"].update({k: screws[k] for k in ("stress_area_mm2", "bolt_shear_mpa",
                                                     "bolt_shear_allow_mpa")})
     return held, found
@@ -440,14 +439,13 @@ def drivetrain(params, design) -> Drivetrain:
                 axis.loads.speed_rpm, life_seat, machine.bearing_life_min_h,
                 2 if axis.roof_pair else 1))
         ends = None
-        stack = stacks[axis.housing]
         if axis.roof_housing is not None:   # from its floor seat to the other housing's roof
             top = axis.roof_housing
             ends = (-size.bearings[0][0].width,
                     base[top] - base[axis.housing] + cavities[top].height
                     + size.bearings[1][0].width)
         elif axis.roof_pair:   # the hollow shaft: from its gear to its flange on the next
-            z_low = min(_mount_fields(m)[1] for m in axis.mounts) - 0.0
+            z_low = min(_mount_fields(m)[1] for m in axis.mounts)
             top = axis.carries
             ends = (z_low, base[top] - base[axis.housing] - walls[top][0])
         flange = None
@@ -455,7 +453,8 @@ def drivetrain(params, design) -> Drivetrain:
             flange = carry_flange(d)
             flange["carries"] = axis.carries
             if report:
-                problems += flange_problems(axis, d, axis.loads.torque_nmm, flange)
+                problems += flange_problems(f"shaft {axis.name}", axis.carries,
+                                            axis.loads.torque_nmm, flange)
         coupling = None
         if axis.floor_through and axis.below(d) > 0:   # a stub for a sprocket or coupling
             coupling, found = coupling_key(axis, d, float(axis.below(d)), machine, report)
@@ -466,7 +465,6 @@ def drivetrain(params, design) -> Drivetrain:
                             float(axis.below(d)) if axis.floor_through else 0.0,
                             axis.above if axis.roof_through else 0.0, axis.note,
                             size.bore, ends, flange, coupling))
-        del stack
     sleeve = next((s for s in shafts if s.name == "S"), None)
     if sleeve is not None and sleeve.diameter > DRIVE_SLEEVE_DIAMETER + 1e-9:
         problems.append(Problem("machine.shafts.S", "sleeve_beyond_drive",

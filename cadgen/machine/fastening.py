@@ -15,7 +15,7 @@ from cadgen.machine.bearings import journal_bore, select_bearing
 from cadgen.machine.catalogue import CatalogueError, socket_screw
 from cadgen.machine.shafts import hub_key, key_pressure
 
-__all__ = ["free_bearing", "flange_problems", "coupling_key", "STUB_CHAMFER",
+__all__ = ["free_bearing", "flange_problems", "coupling_key", "bolt_circle", "STUB_CHAMFER",
            "FLANGE_SHEAR_ALLOW"]
 
 #: The stub's chamfer at each end of a coupling's hub (mm): the key is no longer than the rest.
@@ -44,7 +44,18 @@ def free_bearing(axis, gear, face, d, machine, report):
     return bearing, speed, life, problems
 
 
-def flange_problems(axis, d, torque_nmm, flange) -> list:
+def bolt_circle(bolted: dict, centre=(0.0, 0.0)) -> list:
+    """``[(x, y), ...]`` of the screws of a bolted joint (a carrying flange, a sprocket): its
+    ``bolts`` evenly on ``bolt_circle_radius`` about ``centre``, the first at ``bolt_phase``
+    (rad, default 0) from +x. One rule for the holes in both parts it joins."""
+    count, radius = int(bolted["bolts"]), float(bolted["bolt_circle_radius"])
+    phase = float(bolted.get("bolt_phase", 0.0))
+    return [(centre[0] + radius * math.cos(phase + 2 * math.pi * k / count),
+             centre[1] + radius * math.sin(phase + 2 * math.pi * k / count))
+            for k in range(count)]
+
+
+def flange_problems(name: str, carries: str, torque_nmm: float, flange: dict) -> list:
     """A carrying flange's screws in shear: ``tau = T / (n A_s r)`` (each screw at the bolt circle
     radius ``r``) against ``FLANGE_SHEAR_ALLOW``, about half an 8.8 screw's shear yield (0.577 x
     640 MPa), the service factor already in T. The result rides on ``flange``."""
@@ -58,8 +69,8 @@ def flange_problems(axis, d, torque_nmm, flange) -> list:
     if stress <= FLANGE_SHEAR_ALLOW:
         return []
     return [Problem("machine.shafts", "flange_bolts_overloaded",
-                    f"the flange of shaft {axis.name} ({flange['bolts']} x {flange['bolt']}) "
-                    f"carrying {axis.carries} shears its screws at {stress:.0f} MPa, above "
+                    f"the flange of {name} ({flange['bolts']} x {flange['bolt']}) "
+                    f"carrying {carries} shears its screws at {stress:.0f} MPa, above "
                     f"{FLANGE_SHEAR_ALLOW:g} MPa")]
 
 

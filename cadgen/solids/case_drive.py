@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 
+from cadgen.machine.catalogue import clearance_hole
+from cadgen.machine.fastening import bolt_circle
 from cadgen.solids.parts import Part, planar_transform
 
 __all__ = ["case_drive_parts", "sprocket_tapped_holes"]
@@ -27,13 +29,9 @@ def sprocket_tapped_holes(held: dict, centre, floor_wall: float) -> tuple:
     sprocket = held["sprocket"]
     size = float(sprocket["bolt"].removeprefix("M"))
     depth = min(2.0 * size, floor_wall - 2.0)
-    out = []
-    for k in range(int(sprocket["bolts"])):
-        angle = 2 * math.pi * k / int(sprocket["bolts"]) + math.pi / 4
-        out.append((float(centre[0] + sprocket["bolt_circle_radius"] * math.cos(angle)),
-                    float(centre[1] + sprocket["bolt_circle_radius"] * math.sin(angle)),
-                    TAP_DRILL.get(sprocket["bolt"], 0.8 * size), depth, "floor"))
-    return tuple(out)
+    drill = TAP_DRILL[sprocket["bolt"]]
+    return tuple((float(x), float(y), drill, depth, "floor")
+                 for x, y in bolt_circle(sprocket, tuple(centre)))
 
 
 def case_drive_parts(held: dict, sun_shaft, sun_part, centre, floor_wall: float, gap: float,
@@ -62,11 +60,10 @@ def case_drive_parts(held: dict, sun_shaft, sun_part, centre, floor_wall: float,
     boss = extrude(circle(bracket["boss_diameter"] / 2, segments, tuple(centre)),
                    bracket["boss_length"], holes=[bore], z0=stub_bottom + bracket["plate_thickness"],
                    path="case_drive.bracket")
-    screws = [circle(0.55 * float(sprocket["bolt"].removeprefix("M")), 24, (
-        float(centre[0] + sprocket["bolt_circle_radius"] * math.cos(a)),
-        float(centre[1] + sprocket["bolt_circle_radius"] * math.sin(a))))
-              for a in (2 * math.pi * k / sprocket["bolts"] + math.pi / 4
-                        for k in range(int(sprocket["bolts"])))]
+    # the screws' clearance holes (ISO 273 medium), where the case's tapped holes are
+    hole = clearance_hole(sprocket["bolt"], "medium")
+    screws = [circle(hole / 2, 24, (float(x), float(y)))
+              for x, y in bolt_circle(sprocket, tuple(centre))]
     wheel = extrude(circle(sprocket["tip_diameter"] / 2, segments, tuple(centre)),
                     sprocket["width"],
                     holes=[circle(sprocket["bore"] / 2, segments, tuple(centre)), *screws],

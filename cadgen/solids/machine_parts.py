@@ -266,19 +266,14 @@ def _hollow(solid, shaft, z_bottom: float, z_top: float, segments: int):
 
 def flange_bolt_holes(flange: dict, height: float, segments: int, diameter=None):
     """The carrying flange's bolt holes as cylinders from z = -1 to ``height + 1`` (ISO 273
-    medium clearance holes, or ``diameter``: a tapped hole's drill)."""
-    import math as _math
-
+    medium clearance holes, or ``diameter``: a tapped hole's drill), on its bolt circle
+    (:func:`cadgen.machine.fastening.bolt_circle`, the rule its housing's tapped holes follow)."""
     from cadgen.machine.catalogue import clearance_hole
+    from cadgen.machine.fastening import bolt_circle
     from cadgen.solids.extrude import manifold3d_engine
 
     m3d = manifold3d_engine()
     hole = diameter if diameter is not None else clearance_hole(flange["bolt"], "medium")
-    out = None
-    for k in range(int(flange["bolts"])):
-        angle = 2 * _math.pi * k / int(flange["bolts"])
-        x, y = (flange["bolt_circle_radius"] * _math.cos(angle),
-                flange["bolt_circle_radius"] * _math.sin(angle))
-        cyl = m3d.Manifold.cylinder(height + 2.0, hole / 2, hole / 2, 24).translate((x, y, -1.0))
-        out = cyl if out is None else out + cyl
-    return out
+    cylinders = [m3d.Manifold.cylinder(height + 2.0, hole / 2, hole / 2, 24).translate(
+        (x, y, -1.0)) for x, y in bolt_circle(flange)]
+    return m3d.Manifold.batch_boolean(cylinders, m3d.OpType.Add)

@@ -387,7 +387,7 @@ def mounting_holes(discs, shell, seats, floor_wall: float, segments: int) -> tup
             best = max(clear, key=lambda p: float(np.dot(p, direction)))
             if all(np.linalg.norm(best - q) > 2 * size for q in chosen):
                 chosen.append(best)
-    drill = TAP_DRILL.get(FRAME_MOUNT_BOLT, 0.85 * size)
+    drill = TAP_DRILL[FRAME_MOUNT_BOLT]
     depth = min(2.0 * size, floor_wall - 2.0)
     return tuple((float(x), float(y), drill, depth, "floor") for x, y in chosen)
 
@@ -399,7 +399,10 @@ def floor_holes(drivetrain) -> dict:
     plus the running clearance; the flange that carries a housing (the sleeve S carries gearbox
     1, the hollow shaft C gearbox 2) is screwed into tapped holes of its floor, two screw
     diameters deep (at most the floor less 2 mm), on the flange's bolt circle about the axis."""
-    clearance = drivetrain.rules.get("fits", {}).get("running_clearance_mm", 1.0)
+    from cadgen.machine.fastening import bolt_circle
+    from cadgen.machine.fits import process_fits
+
+    clearance = process_fits(drivetrain.process).running_clearance
     floors = {name: stack.floor_wall for name, stack in drivetrain.stacks.items()}
     out = {name: ([], []) for name in drivetrain.stacks}
     for shaft in drivetrain.shafts:
@@ -412,12 +415,9 @@ def floor_holes(drivetrain) -> dict:
         if flange and flange["carries"] in out:
             size = float(flange["bolt"].removeprefix("M"))
             depth = min(2.0 * size, floors[flange["carries"]] - 2.0)
-            for k in range(int(flange["bolts"])):
-                angle = 2 * math.pi * k / int(flange["bolts"])
-                out[flange["carries"]][1].append(
-                    (flange["bolt_circle_radius"] * math.cos(angle),
-                     flange["bolt_circle_radius"] * math.sin(angle),
-                     TAP_DRILL.get(flange["bolt"], 0.8 * size), depth, "floor"))
+            drill = TAP_DRILL[flange["bolt"]]
+            out[flange["carries"]][1].extend((x, y, drill, depth, "floor")
+                                             for x, y in bolt_circle(flange))
     return {name: (tuple(p), tuple(t)) for name, (p, t) in out.items()}
 
 
