@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass
 
 from kinematics.errors import DesignError
+from kinematics.profile_shift import undercut_free_shift
 
 __all__ = ["MIN_CIRCULAR_TEETH", "circular_module", "planting_circular_radii", "planting_modules",
            "TRAIN1_SETS", "train1_set_radii", "holding_set_module", "holding_set_design",
@@ -206,11 +207,6 @@ def working_shift_sum(z1: int, z2: int, module: float, axis_distance: float,
     return (z1 + z2) * (_involute(alpha_w) - _involute(pressure_angle)) / (2 * math.tan(pressure_angle))
 
 
-def _undercut_free(z: int, pressure_angle: float) -> float:
-    """The least shift that keeps a rack from undercutting ``z`` teeth: ``1 - z sin^2 alpha / 2``."""
-    return 1.0 - z * math.sin(pressure_angle) ** 2 / 2
-
-
 def _shifted_set(radii, distances, q_fraction, module, pressure_angle):
     """Teeth and shifts of a set at ``module``: the sun's and planet's counts in the exact ratio
     ``q_fraction`` nearest their radii, the idlers' nearest theirs, the three shift sums from
@@ -232,7 +228,9 @@ def _shifted_set(radii, distances, q_fraction, module, pressure_angle):
                                       pressure_angle) for i in range(3)]
         except ValueError:
             continue
-        floor = [_undercut_free(z, pressure_angle) for z in teeth]
+        # the least shift each keeps free of undercut by the standard rack (ha* = 1)
+        floor = [float(undercut_free_shift(module * z / 2, module, pressure_angle))
+                 for z in teeth]
         # x = (x_s, S1 - x_s, S2 - S1 + x_s, S3 - S2 + S1 - x_s): each a_i + s_i x_s
         signs = (1.0, -1.0, 1.0, -1.0)
         offsets = (0.0, sums[0], sums[1] - sums[0], sums[2] - sums[1] + sums[0])
