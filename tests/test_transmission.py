@@ -201,3 +201,25 @@ def test_set_i_meets_its_axes_standard_or_shifted(R, i12, i13, n):
         assert all(x >= 1 - teeth * math.sin(alpha) ** 2 / 2 - 1e-9
                    for x, teeth in zip(design.shifts, z)), (z, design.shifts)
         assert max(abs(x) for x in design.shifts) <= 0.5
+
+
+def test_the_drive_steps_its_module_up_where_the_trains_reaches_no_teeth():
+    """i13 = 0.2 leaves set II a 0.8 mm module: no teeth up to 150 clear 65 mm hubs and reach
+    n = 3 there (at least 7.5 + 65 / 0.8 = 88.75 teeth each; drive_design refuses), so the drive
+    takes the next ISO 54 module that does; its teeth still give n exactly and clear the hubs
+    (rim rule checked here by hand)."""
+    from fractions import Fraction
+
+    from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, TrainAxes, planting_drive
+    from cadgen.gears.drive import drive_design
+    from kinematics.errors import DesignError
+
+    hubs = (65.0, 65.0, 65.0, 65.0)
+    with pytest.raises(DesignError):
+        drive_design(3.0, 30.0, 0.8, DRIVE_SLEEVE_DIAMETER, hubs=hubs)
+    drive = planting_drive(TrainAxes(36.0, 1.2, 0.2, 3.0), 0.8, hubs=hubs)
+    assert drive.module_1 == 1.0   # the first of ISO 54's series above 0.8 that works
+    z1, z2, z3, z4 = drive.teeth
+    assert Fraction(z1 * z4, z2 * z3) == 3
+    for z in drive.teeth:   # root circle 2.5 modules clear of a 65 mm hub
+        assert z * drive.module_1 / 2 - 1.25 * drive.module_1 - 32.5 >= 2.5 * drive.module_1 - 1e-9

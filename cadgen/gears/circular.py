@@ -409,12 +409,25 @@ def planting_drive(mechanism, module_c: float, requested=None, carrier_rpm: floa
     the larger of train 1's two modules (``module_c`` set II's, as :func:`planting_modules`
     gives it; ``requested`` the file's ``gears.circular_module``); ``hubs``: each gear's hub
     diameter (input gear 1, the central shaft's, input gear 2, the driven gear's) its rim
-    must clear, once the drivetrain has sized their shafts."""
+    must clear, once the drivetrain has sized their shafts. When no set of teeth reaches n at
+    that module (a small module's gears cannot clear the hubs within ``max_teeth``), the next
+    module of ISO 54's first series (``DRIVE_MODULES``) that does; the last refusal otherwise."""
     from cadgen.gears.drive import drive_design
 
     try:
         module_i = holding_set_module(mechanism, requested, pressure_angle)
     except DesignError:
         module_i = module_c
-    return drive_design(mechanism.n, carrier_rpm, max(module_c, module_i), DRIVE_SLEEVE_DIAMETER,
-                        hubs=hubs)
+    module = max(module_c, module_i)
+    refusal = None
+    for candidate in [module] + [m for m in DRIVE_MODULES if m > module]:
+        try:
+            return drive_design(mechanism.n, carrier_rpm, candidate, DRIVE_SLEEVE_DIAMETER,
+                                hubs=hubs)
+        except DesignError as error:
+            refusal = error
+    raise refusal
+
+
+#: Modules the drive may step up to when the train's does not reach n (ISO 54, first series).
+DRIVE_MODULES = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0)
