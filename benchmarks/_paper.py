@@ -14,7 +14,7 @@ _Z = (0.0, 0.0, 1.0)
 def sweep_cases():
     """``[(label, scene factory, lipschitz, acceleration, upper)]`` with the build's own bounds."""
     from cadgen.pipeline.build import STAGE_FUNCTIONS, _Build
-    from cadgen.pipeline.clearances import ARM_PARTS, _arm_bounds
+    from cadgen.pipeline.clearances import _arm_bounds, arm_groups
     from cadgen.params import load_params
     from cadgen.sweep.fcl import FclScene
     from cadgen.sweep.scene import part_reach
@@ -30,12 +30,12 @@ def sweep_cases():
     halves = ("base", "cover")
     ground_speed = max(max(part_reach(parts[f"gearbox1-{h}"], axis=_Z) for h in halves),
                        rc + max(part_reach(parts[f"gearbox2-{h}"], axis=_Z) for h in halves))
-    arm = [n for n in ARM_PARTS if n in parts]
+    arm1, arm2 = arm_groups(assembly)
     housings = ([f"gearbox1-{h}" for h in halves]
                 + [f"gearbox2-{h}-arm{k}" for h in halves for k in (1, 2)])
     return [
         ("arm to arm (blades included)",
-         lambda: FclScene(assembly, [f"{n}-arm1" for n in arm], [f"{n}-arm2" for n in arm]),
+         lambda: FclScene(assembly, arm1, arm2),
          2 * speed, 2 * acceleration, math.pi),
         ("housings to ground",
          lambda: FclScene(assembly, housings, ["ground"]),

@@ -27,12 +27,14 @@ ALLOWED = {
     # loading calls the design checks, inside a function (see cadgen.params.feasibility)
     "cadgen.params": {"kinematics", "cadgen.params.feasibility"},
     "cadgen.gears": {"kinematics"},
-    "cadgen.assembly": set(),        # the joint graph (standard library only)
     "cadgen.cam": {"kinematics"},
     # shafts, keys, bearings and fits: the machine-design rules (numbers and tables, no solids)
     "cadgen.machine": {"kinematics", "cadgen.params", "cadgen.geometry", "cadgen.gears"},
+    # the assembly model: the machine's records as parts, joints (with their bought items from
+    # the machine's catalogues) and placements; no numpy
+    "cadgen.assembly": {"cadgen.machine"},
     "cadgen.solids": {"kinematics", "cadgen.params", "cadgen.geometry", "cadgen.gears",
-                      "cadgen.machine"},
+                      "cadgen.machine", "cadgen.assembly"},
     "cadgen.design": {"kinematics", "cadgen.solids"},
     "cadgen.sweep": {"kinematics", "cadgen.solids"},
     "cadgen.params.feasibility": {"kinematics", "cadgen.params", "cadgen.design", "cadgen.cam"},

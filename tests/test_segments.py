@@ -179,23 +179,28 @@ def test_bad_build_volumes_are_refused(printed, volume, margin):
 def test_the_rest_of_the_pipeline_sees_the_segments(printed):
     from cadgen.export.meshes import material_key
     from cadgen.pipeline.clearances import _present
-    from cadgen.report.bom import _bought_rows, _copies
+    from cadgen.report.bom import _bought_rows
 
-    params, assembly, (box1, box2, *_) = printed
+    params, assembly, (box1, box2, *rest) = printed
     housings = {"gearbox1": box1, "gearbox2": box2}
     assert [r["housing"] for r in enclosure_checks(assembly, housings)] == ["gearbox1", "gearbox2"]
-    assert _copies(assembly) == {"gearbox1": 1, "gearbox2": 2, "frame": 1}
+    # the assembly model places each segment as often as its housing: gearbox 2 once per arm
+    copies = {p.name: len(p.instances) for p in assembly.parts if p.kind == "housing"}
+    assert {copies[f"gearbox1-base-{k}"] for k in (1, 2, 3)} == {1}
+    assert copies["gearbox2-base"] == copies["gearbox2-cover"] == 2
     assert material_key("gearbox1-cover-2", "housing") == "housing-cover"
     assert material_key("gearbox1-base-2", "housing") == "housing"
     parts = {p.name: p for p in assembly.parts}
     assert _present(("gearbox1-base", "gearbox2-cover"), parts) == [
         "gearbox1-base-1", "gearbox1-base-2", "gearbox1-base-3", "gearbox2-cover"]
-    train = drivetrain(params, build_mechanism(params))
 
-    def screws(housing):
-        rows = _bought_rows(train, {"gearbox1": housing}, {"gearbox1": 1}, set())
-        return sum(r["quantity"] for r in rows if r["part"] == "socket head cap screw")
+    def screws(model):
+        return sum(r["quantity"] for r in _bought_rows(model, None)
+                   if r["part"] == "socket head cap screw")
 
-    from dataclasses import replace
-    assert screws(box1) - screws(replace(box1, joints=())) == sum(len(j.bolts) for j in box1.joints)
+    # each splice's bolts are bought once per placed copy of its housing
+    spliced = sum(len(j.bolts) for j in box1.joints) + 2 * sum(len(j.bolts) for j in box2.joints)
+    spliced += sum(len(j.bolts) for housing in rest for j in getattr(housing, "joints", ()))
+    model = assembly.model
+    assert screws(model) - screws(model.without(lambda j: j.detail.startswith("splice"))) == spliced
     assert Counter(len(j.bolts) for j in box1.joints) == {4: 2}

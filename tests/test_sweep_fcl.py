@@ -315,10 +315,9 @@ def _brute_distance(assembly, group_a, group_b, phi, models={}):
 
 
 def _arm_groups(assembly):
-    from cadgen.pipeline.clearances import ARM_PARTS as ALL_ARM_PARTS, _present
+    from cadgen.pipeline.clearances import arm_groups
 
-    present = _present(ALL_ARM_PARTS, {part.name: part for part in assembly.parts})
-    return [f"{n}-arm1" for n in present], [f"{n}-arm2" for n in present]
+    return arm_groups(assembly)
 
 
 def test_scene_distance_is_the_least_of_every_pair_by_brute_force(planting):

@@ -18,6 +18,7 @@ Counting rule (the reason for each choice is in :meth:`AssemblyModel.mobility`):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, Union
 
@@ -32,13 +33,55 @@ MOBILITY_FORMULA = "M = 3 (N - 1) - 2 J1 - J2"
 
 
 @dataclass(frozen=True)
+class Item:
+    """A bought item a joint is made with, ``count`` of them per joint: a bearing, a key, a screw.
+
+    ``kind`` is what the bill calls it (``"bearing"``, ``"key"``, ``"socket head cap screw"``,
+    ...), ``description`` the full line a buyer orders from, ``designation`` the standard's
+    short name.
+    """
+
+    kind: str
+    description: str
+    designation: str
+    count: int = 1
+
+    def __post_init__(self):
+        if not isinstance(self.count, int) or isinstance(self.count, bool) or self.count < 1:
+            raise ValueError(f"{self.description}: a joint needs a whole positive number of "
+                             f"each item, not {self.count!r}")
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "description": self.description,
+                "designation": self.designation, "count": self.count}
+
+
+@dataclass(frozen=True)
+class Placement:
+    """One placed copy of a made part: ``instance`` (a part of the graph) is the file ``part``
+    riding on the kinematic ``body`` at carrier angle plus ``phase`` (rad)."""
+
+    instance: str
+    part: str
+    body: str
+    phase: float = 0.0
+
+    def as_tuple(self) -> tuple:
+        """``(instance, body, phase)``, as a solid part lists its instances."""
+        return (self.instance, self.body, self.phase)
+
+
+@dataclass(frozen=True)
 class Joint:
-    """One joint between parts ``a`` and ``b``; ``detail`` says what makes it (for the reader)."""
+    """One joint between parts ``a`` and ``b``; ``detail`` says what makes it (for the reader),
+    ``items`` what is bought to make it (not part of its identity: equal joints differ only in
+    what they are, not in the screws counted for them)."""
 
     kind: str
     a: str
     b: str
     detail: str = ""
+    items: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         if self.kind not in JOINT_KINDS:
@@ -48,13 +91,20 @@ class Joint:
                 raise ValueError(f"{self}: a part name is a non-empty string, not {name!r}")
         if self.a == self.b:
             raise ValueError(f"{self}: a joint ties two different parts, not a part to itself")
+        object.__setattr__(self, "items", tuple(self.items))
+        for item in self.items:
+            if not isinstance(item, Item):
+                raise TypeError(f"{self}: an item is an Item, not {item!r}")
 
     def __str__(self):
         detail = f" ({self.detail})" if self.detail else ""
         return f"{self.kind} joint {self.a}–{self.b}{detail}"
 
     def as_dict(self) -> dict:
-        return {"kind": self.kind, "a": self.a, "b": self.b, "detail": self.detail}
+        out = {"kind": self.kind, "a": self.a, "b": self.b, "detail": self.detail}
+        if self.items:
+            out["items"] = [item.as_dict() for item in self.items]
+        return out
 
 
 def connected_groups(parts: Iterable[str], links: Iterable[tuple[str, str]]) -> list[list[str]]:
@@ -87,18 +137,27 @@ JointSelector = Union[Joint, Callable[[Joint], bool]]
 
 @dataclass(frozen=True)
 class AssemblyModel:
-    """Parts, the joints between them, and which part is the frame (the ground)."""
+    """Parts, the joints between them, which part is the frame (the ground), and where each
+    made part's copies are placed (``placements``: the solids, the assembly file, the bill's
+    quantities and the sweeps read them from here). ``made``: the parts the machine's files
+    make or its bill buys as solids (a part outside it, such as the user's own coupling, is
+    in the graph for what holds it)."""
 
     parts: tuple[str, ...]
     joints: tuple[Joint, ...] = ()
     frame: str = "frame"
+    placements: tuple[Placement, ...] = ()
+    made: tuple[str, ...] = ()
     _body_index: dict = field(init=False, repr=False, compare=False, hash=False)
 
     def __post_init__(self):
         object.__setattr__(self, "parts", tuple(self.parts))
         object.__setattr__(self, "joints", tuple(self.joints))
+        object.__setattr__(self, "placements", tuple(self.placements))
+        object.__setattr__(self, "made", tuple(self.made))
         self._check_parts()
         self._check_joints()
+        self._check_placements()
         object.__setattr__(self, "_body_index", self._index_bodies())
 
     def _check_parts(self):
@@ -120,6 +179,20 @@ class AssemblyModel:
             for name in (joint.a, joint.b):
                 if name not in known:
                     raise ValueError(f"{joint} names the unknown part {name!r}")
+
+    def _check_placements(self):
+        known, seen = set(self.parts), set()
+        for placement in self.placements:
+            if not isinstance(placement, Placement):
+                raise TypeError(f"a placement is a Placement, not {placement!r}")
+            if placement.instance not in known:
+                raise ValueError(f"{placement} places {placement.instance!r}, which is not a part")
+            if placement.instance in seen:
+                raise ValueError(f"{placement.instance!r} is placed twice")
+            seen.add(placement.instance)
+        unknown = [part for part in self.made if part not in known]
+        if unknown:
+            raise ValueError(f"the made parts {unknown} are not parts")
 
     def _index_bodies(self) -> dict[str, frozenset[str]]:
         fixed = [(j.a, j.b) for j in self.joints if j.kind == FIXED]
@@ -198,6 +271,34 @@ class AssemblyModel:
                     if self.frame in group)
         return [part for part in self.parts if part not in held]
 
+    # --- placements and bought items ---------------------------------------------------
+
+    def instances_of(self, part: str) -> tuple[tuple, ...]:
+        """``(instance, body, phase)`` of every placed copy of the made ``part`` (a file stem)."""
+        return tuple(p.as_tuple() for p in self.placements if p.part == part)
+
+    def placed_parts(self) -> tuple[str, ...]:
+        """The made parts (file stems) the model places, in placement order."""
+        return tuple(dict.fromkeys(p.part for p in self.placements))
+
+    def bought(self, present: Iterable[str] | None = None) -> list[tuple[Item, int]]:
+        """Every bought item the joints need, summed: ``[(item, total)]`` in first-seen order.
+
+        ``present``: the instances that were made (a build that cut no gears has no keys to
+        buy for them). A joint counts when each of its parts is present or is not one of the
+        machine's own parts (``made``: the user's coupling is not); None counts every joint.
+        """
+        own = set(self.made)
+        made = None if present is None else set(present)
+        totals: dict[tuple, list] = {}
+        for joint in self.joints:
+            if made is not None and any(p in own and p not in made for p in (joint.a, joint.b)):
+                continue
+            for item in joint.items:
+                key = (item.kind, item.description, item.designation)
+                totals.setdefault(key, [item, 0])[1] += item.count
+        return [(item, total) for item, total in totals.values()]
+
     # --- editing ------------------------------------------------------------------------
 
     def without(self, joint_or_predicate: JointSelector) -> AssemblyModel:
@@ -215,11 +316,12 @@ class AssemblyModel:
         else:
             raise TypeError(f"without() takes a Joint or a Joint -> bool, not {joint_or_predicate!r}")
         kept = tuple(j for j in self.joints if not drop(j))
-        return AssemblyModel(self.parts, kept, self.frame)
+        return AssemblyModel(self.parts, kept, self.frame, self.placements, self.made)
 
     def with_joints(self, *joints: Joint) -> AssemblyModel:
         """A copy with ``joints`` added at the end (their parts must already be parts)."""
-        return AssemblyModel(self.parts, self.joints + joints, self.frame)
+        return AssemblyModel(self.parts, self.joints + joints, self.frame, self.placements,
+                             self.made)
 
     # --- reports ------------------------------------------------------------------------
 
@@ -234,6 +336,9 @@ class AssemblyModel:
             "mobility_rule": rule,
             "unconnected": self.unconnected(),
             "bodies": [[p for p in self.parts if p in body] for body in self.bodies()],
+            "placements": [{"instance": p.instance, "part": p.part, "body": p.body,
+                            "phase_deg": round(math.degrees(p.phase), 9)}
+                           for p in self.placements],
         }
 
     def degrees_of_freedom_check(self, expected: int = 1) -> list[str]:

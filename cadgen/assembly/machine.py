@@ -1,27 +1,49 @@
-"""A mechanism's joint graph from its drivetrain records: every part and what holds it.
+"""A mechanism's assembly model from its drivetrain records: every part, what holds it, where it is.
 
 Built from the same records the solids are (:class:`cadgen.machine.model.Drivetrain`: shafts,
 their seats and hubs; the gear train's meshes), duck-typed so this package stays free of
 numpy. Part names are the assembly's instance names (``shaft-A-side1``, ``sun-side1``,
-``gearbox2-base-arm1``, ...): the joints speak of the parts the GLB and the bill show.
+``gearbox2-base-arm1``, ...): the solids, the GLB's nodes, the bill and the sweeps use them.
+
+This module is the one place that decides which copies of a made part exist: gearbox 1's
+axes on both sides of carrier 1 (side 2 is side 1's part turned half a turn about O),
+gearbox 2, the cam, the planter and its blades once per arm (arm 2 half a carrier turn on),
+the frame and its shafts once. Given the made parts' bodies (``bodies``: each part's
+kinematic body, where its solid is drawn) the model places every copy
+(:class:`~cadgen.assembly.graph.Placement`); given the housing records (``housings``) its
+flange and splice joints carry their bolts. Every joint carries the bought items it is
+made with (:mod:`cadgen.assembly.items`): bearings, keys, screws, nuts and washers.
 
 Each shaft is one revolute joint to the housing its first bearing is in (its other bearing is
 coaxial: in the plane it adds nothing, so it is named in the joint's detail, not counted
-twice); a keyed gear is fixed to its shaft, a gear running free on its bearings is a revolute
-joint to it; a hollow shaft's flange is fixed to the housing it carries. A joint the workshop
-does not yet get as parts (the planter's fixing on shaft E, the cam's screws, the blades'
-hinge pins and the duckbill linkage between cam and blades) is in the graph for its kinematics
-and listed in :data:`NOT_MADE` so the report claims nothing it does not make.
+twice, and its bearings are bought with that joint); a keyed gear is fixed to its shaft, a
+gear running free on its bearings is a revolute joint to it; a hollow shaft's flange is fixed
+to the housing it carries. A joint the workshop does not yet get as parts (the planter's
+fixing on shaft E, the cam's screws, the blades' hinge pins and the duckbill linkage between
+cam and blades) is in the graph for its kinematics and listed in :data:`NOT_MADE` so the
+report claims nothing it does not make.
 """
 
 from __future__ import annotations
 
-from cadgen.assembly.graph import AssemblyModel, Joint
+import math
+import re
 
-__all__ = ["planting_model", "pricking_model", "NOT_MADE", "model_report"]
+from cadgen.assembly.graph import AssemblyModel, Joint, Placement
+from cadgen.assembly.items import (bearing_item, bolted_flange_items, key_item, screw_items,
+                                   sprocket_items)
+
+__all__ = ["planting_model", "pricking_model", "NOT_MADE", "model_report", "ENVIRONMENT"]
 
 #: Details of joints the graph holds for their kinematics but the build does not make as parts.
 NOT_MADE = ("not yet made",)
+#: Made solids that are not parts of the machine (the soil slab): the model places none.
+ENVIRONMENT = frozenset({"ground"})
+#: The copies of a part, by instance suffix: (body suffix, phase in rad). Side 2 of carrier 1
+#: is side 1's part turned half a turn about O (``carrier1:mirrored``); arm 2 rides half a
+#: carrier turn after arm 1.
+COPIES = {None: ("", 0.0), "side1": ("", 0.0), "side2": (":mirrored", 0.0),
+          "arm1": ("", 0.0), "arm2": ("", math.pi)}
 
 
 def _slug(name: str) -> str:
@@ -29,18 +51,72 @@ def _slug(name: str) -> str:
 
 
 class _Builder:
-    def __init__(self, frame: str):
-        self.parts, self.joints = [frame], []
-        self.frame = frame
+    """Parts, joints and placements as the machine's builder adds them.
 
-    def joint(self, kind, a, b, detail=""):
+    ``bodies``: ``{made part: kinematic body}``; None builds the graph alone (no placements).
+    """
+
+    def __init__(self, bodies=None, housings=None):
+        self.parts, self.joints, self.placements, self.made = [], [], [], []
+        self.bodies = bodies
+        self.housings = housings or {}
+        self._placed = set()
+
+    def instance(self, stem: str, copy: str | None = None) -> str:
+        """The instance name of ``stem``'s ``copy``, placed when ``stem`` is a made part."""
+        name = stem if copy is None else f"{stem}-{copy}"
+        if name not in self.parts:
+            self.parts.append(name)
+        if name not in self.made:
+            self.made.append(name)
+        if self.bodies is not None and stem in self.bodies and name not in self._placed:
+            suffix, phase = COPIES[copy]
+            self.placements.append(Placement(name, stem, self.bodies[stem] + suffix, phase))
+            self._placed.add(name)
+        return name
+
+    def joint(self, kind, a, b, detail="", items=()):
         for part in (a, b):
             if part not in self.parts:
                 self.parts.append(part)
-        self.joints.append(Joint(kind, a, b, detail))
+        self.joints.append(Joint(kind, a, b, detail, tuple(items)))
 
-    def model(self) -> AssemblyModel:
-        return AssemblyModel(tuple(self.parts), tuple(self.joints), self.frame)
+    def housing(self, name: str, copy: str | None = None) -> str:
+        """A split housing's halves (and the segments a printer needed), bolted together; the
+        instance of its base (its first segment) that other parts join."""
+        record = self.housings.get(name)
+        halves = {}
+        for half in ("base", "cover"):
+            stem = f"{name}-{half}"
+            cut = sorted((s for s in (self.bodies or {}) if re.fullmatch(rf"{stem}-\d+", s)),
+                         key=lambda s: int(s.rsplit("-", 1)[1]))
+            halves[half] = [self.instance(s, copy) for s in (cut or [stem])]
+        bolts = ()
+        if record is not None and getattr(record, "bolt_positions", None) is not None:
+            bolts = bolted_flange_items(record.bolt_size, 2 * float(record.flange_thickness),
+                                        len(record.bolt_positions))
+        for k, (cover, base) in enumerate(zip(halves["cover"], halves["base"])):
+            self.joint("fixed", cover, base, "flange bolts", bolts if k == 0 else ())
+        splices = list(getattr(record, "joints", ()) or ())
+        for k, splice in enumerate(splices):
+            for half in ("base", "cover"):
+                pieces = halves[half]
+                if k + 1 < len(pieces):
+                    items = (bolted_flange_items(splice.bolt_size, float(splice.grip),
+                                                 len(splice.bolts)) if half == "base" else ())
+                    self.joint("fixed", pieces[k + 1], pieces[k],
+                               f"splice {k + 1}" + (" (its bolts join both halves)"
+                                                    if half == "base" else ""), items)
+        return halves["base"][0]
+
+    def model(self, frame: str) -> AssemblyModel:
+        if self.bodies is not None:
+            missing = sorted(set(self.bodies) - ENVIRONMENT - {p.part for p in self.placements})
+            if missing:
+                raise ValueError(f"the assembly model places no copy of the made parts {missing}")
+        parts = [frame] + [p for p in self.parts if p != frame]
+        return AssemblyModel(tuple(parts), tuple(self.joints), frame, tuple(self.placements),
+                             tuple(self.made))
 
 
 def _bearings(shaft) -> str:
@@ -48,56 +124,76 @@ def _bearings(shaft) -> str:
                      for seat in shaft.seats)
 
 
-def planting_model(drivetrain, meshes=()) -> AssemblyModel:
-    """The planting machine's joint graph: frame, drive, gearbox 1 and both arms.
+def _seat_items(shaft) -> tuple:
+    return tuple(bearing_item(seat.bearing, getattr(seat, "count", 1)) for seat in shaft.seats)
+
+
+def _mount_joint(b, gear, shaft_instance, mount):
+    """A gear on its shaft: free on two bearings (a revolute), keyed, or on a D-flat."""
+    if getattr(mount, "bearing", None) is not None:
+        b.joint("revolute", gear, shaft_instance, f"runs free on 2 x {mount.bearing.designation}",
+                (bearing_item(mount.bearing, 2),))
+    elif mount.key is not None:
+        b.joint("fixed", gear, shaft_instance, mount.key.designation, (key_item(mount.key),))
+    else:
+        b.joint("fixed", gear, shaft_instance, f"D-flat {mount.flat_depth:g} mm")
+
+
+def _flange_items(flange) -> tuple:
+    return screw_items(flange["bolt"], float(flange["thickness"]), int(flange["bolts"]))
+
+
+def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> AssemblyModel:
+    """The planting machine's assembly model: frame, drive, gearbox 1 and both arms.
 
     ``meshes``: the gear train's ``(drive, driven)`` gear names of every pair (the stages'
-    ``pair.names``); each becomes a gear joint between the gears' instances.
+    ``pair.names``); each becomes a gear joint between the gears' instances. ``bodies``: the
+    made parts' kinematic bodies (``{part.name: part.body}`` of the solids), to place their
+    copies; ``housings``: ``{"gearbox1": record, "gearbox2": ..., "frame": ...}`` split
+    housing records, whose flange bolts (and splices) their joints then carry.
     """
-    b = _Builder("frame-base")
-    b.joint("fixed", "frame-cover", "frame-base", "flange bolts")
-    b.joint("fixed", "gearbox1-cover", "gearbox1-base", "flange bolts")
-    for arm in (1, 2):
-        b.joint("fixed", f"gearbox2-cover-arm{arm}", f"gearbox2-base-arm{arm}", "flange bolts")
+    b = _Builder(bodies, housings)
+    frame = b.housing("frame")
+    box1 = b.housing("gearbox1")
+    box2 = {arm: b.housing("gearbox2", f"arm{arm}") for arm in (1, 2)}
 
     def housing_part(housing, side):
-        return {"frame": "frame-base", "gearbox1": "gearbox1-base"}.get(
-            housing, f"gearbox2-base-arm{side}")
+        return {"frame": frame, "gearbox1": box1}.get(housing) or box2[side]
 
-    def shaft_part(shaft, side):
+    def copy_of(shaft, side):
         if shaft.housing == "frame":
-            return f"shaft-{shaft.name}"
-        if shaft.housing == "gearbox2":
-            return f"shaft-{shaft.name}-arm{side}"
-        return f"shaft-{shaft.name}-side{side}"
+            return None
+        return f"arm{side}" if shaft.housing == "gearbox2" else f"side{side}"
 
     gear_instances = {}   # gear name -> {side: instance}
     for shaft in drivetrain.shafts:
         sides = (shaft.side,) if shaft.housing != "gearbox2" else (1, 2)
         for side in sides:
-            me = shaft_part(shaft, side)
-            first = shaft.seats[0]
+            me = b.instance(f"shaft-{shaft.name}", copy_of(shaft, side))
+            b.joint("revolute", me, housing_part(shaft.seats[0].housing, side), _bearings(shaft),
+                    _seat_items(shaft))
             if shaft.flange:   # a hollow shaft: in its bearing pair, bolted to what it carries
-                b.joint("revolute", me, housing_part(first.housing, side), _bearings(shaft))
                 b.joint("fixed", me, housing_part(shaft.flange["carries"], side),
-                        f"flange: {shaft.flange['bolts']} x {shaft.flange['bolt']} screws")
-            else:
-                b.joint("revolute", me, housing_part(first.housing, side), _bearings(shaft))
+                        f"flange: {shaft.flange['bolts']} x {shaft.flange['bolt']} screws",
+                        _flange_items(shaft.flange))
+            coupling = getattr(shaft, "coupling_key", None)
+            if coupling is not None and side == 1:   # the user's sprocket or coupling hub
+                b.joint("fixed", "input-coupling", me,
+                        f"the user's sprocket or coupling hub on the stub: {coupling.designation}",
+                        (key_item(coupling),))
             for mount in shaft.mounts:
                 stem = _slug(mount.gear)   # the gear's file stem, as its STL and GLB node
+                # a gear is copied as the housing it turns in is (C2's central gear, inside
+                # gearbox 2, once per arm; planet I beside it in gearbox 1, once per side)
+                housing = getattr(mount, "housing", "") or shaft.housing
                 if shaft.housing == "frame" and shaft.name == "input":
-                    gear = stem
-                elif shaft.housing == "gearbox2":
-                    gear = f"{stem}-arm{side}"
+                    gear = b.instance(stem)
+                elif housing == "gearbox2":
+                    gear = b.instance(stem, f"arm{side}")
                 else:
-                    gear = f"{stem}-side{side}"
+                    gear = b.instance(stem, f"side{side}")
                 gear_instances.setdefault(mount.gear, {})[side] = gear
-                if mount.bearing is not None:
-                    b.joint("revolute", gear, me, f"runs free on 2 x {mount.bearing.designation}")
-                elif mount.key is not None:
-                    b.joint("fixed", gear, me, mount.key.designation)
-                else:
-                    b.joint("fixed", gear, me, f"D-flat {mount.flat_depth:g} mm")
+                _mount_joint(b, gear, me, mount)
     for drive, driven in meshes:
         one, two = gear_instances.get(drive, {}), gear_instances.get(driven, {})
         for side in (1, 2):
@@ -107,49 +203,53 @@ def planting_model(drivetrain, meshes=()) -> AssemblyModel:
                 b.joint("gear", a, c, f"mesh {drive} - {driven}")
     # on the arms: the cam on gearbox 2, the planter on shaft E, the blades on the planter
     for arm in (1, 2):
-        box = f"gearbox2-base-arm{arm}"
-        b.joint("fixed", f"cam-arm{arm}", box, "on gearbox 2's roof over E: " + NOT_MADE[0]
-                + " (screws)")
-        b.joint("fixed", f"planter-shell-arm{arm}", f"shaft-E-arm{arm}",
-                "on shaft E: " + NOT_MADE[0] + " (bore and key)")
+        copy = f"arm{arm}"
+        b.joint("fixed", b.instance("cam", copy), box2[arm],
+                "on gearbox 2's roof over E: " + NOT_MADE[0] + " (screws)")
+        planter = b.instance("planter-shell", copy)
+        b.joint("fixed", planter, f"shaft-E-{copy}", "on shaft E: " + NOT_MADE[0] + " (bore and key)")
         for blade in ("blade-right", "blade-left"):
-            b.joint("revolute", f"{blade}-arm{arm}", f"planter-shell-arm{arm}",
-                    "hinge: " + NOT_MADE[0] + " (pin)")
-            b.joint("cam", f"{blade}-arm{arm}", f"cam-arm{arm}",
+            me = b.instance(blade, copy)
+            b.joint("revolute", me, planter, "hinge: " + NOT_MADE[0] + " (pin)")
+            b.joint("cam", me, f"cam-{copy}",
                     "opened by the cam through the duckbill linkage: " + NOT_MADE[0])
-    return b.model()
+    return b.model(frame)
 
 
-def pricking_model(drivetrain, meshes=()) -> AssemblyModel:
-    """The pricking machine's joint graph: the frame bracket holding the sun's shaft by its
+def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> AssemblyModel:
+    """The pricking machine's assembly model: the frame bracket holding the sun's shaft by its
     stub's key, the gear case turning on that shaft and driven by the sprocket bolted to it,
-    the intermediate and planet shafts in the case, the rocker and needle on the planet."""
+    the intermediate and planet shafts in the case, the rocker and needle on the planet.
+    ``bodies`` and ``housings`` (``{"gear-case": record}``) as for :func:`planting_model`."""
     held = drivetrain.rules.get("case_drive")
-    b = _Builder("frame-bracket")
-    b.joint("fixed", "gear-case-cover", "gear-case-base", "flange bolts")
+    b = _Builder(bodies, housings)
+    frame = b.instance("frame-bracket")
+    case = b.housing("gear-case")
     gears = {}
     for shaft in drivetrain.shafts:
-        me = f"shaft-{shaft.name}"
+        me = b.instance(f"shaft-{shaft.name}")
         if shaft.name == "sun":   # the sun does not turn: its shaft's stub keyed in the bracket
-            b.joint("fixed", me, "frame-bracket",
-                    shaft.coupling_key.designation if shaft.coupling_key is not None
-                    else "stub in the bracket: " + NOT_MADE[0] + " (key)")
-        b.joint("revolute", me, "gear-case-base", _bearings(shaft))
+            key = shaft.coupling_key
+            b.joint("fixed", me, frame,
+                    key.designation if key is not None
+                    else "stub in the bracket: " + NOT_MADE[0] + " (key)",
+                    (key_item(key),) if key is not None else ())
+        b.joint("revolute", me, case, _bearings(shaft), _seat_items(shaft))
         for mount in shaft.mounts:
-            gear = _slug(mount.gear)
+            gear = b.instance(_slug(mount.gear))
             gears[mount.gear] = gear
-            b.joint("fixed", gear, me, mount.key.designation if mount.key is not None
-                    else f"D-flat {mount.flat_depth:g} mm")
+            _mount_joint(b, gear, me, mount)
     if held:
         sprocket = held["sprocket"]
-        b.joint("fixed", "case-sprocket", "gear-case-base",
-                f"{sprocket['bolts']} x {sprocket['bolt']} screws (the chain drives it)")
+        b.joint("fixed", b.instance("case-sprocket"), case,
+                f"{sprocket['bolts']} x {sprocket['bolt']} screws (the chain drives it)",
+                sprocket_items(held))
     for drive, driven in meshes:
         if drive in gears and driven in gears:
             b.joint("gear", gears[drive], gears[driven], f"mesh {drive} - {driven}")
-    b.joint("fixed", "rocker", "shaft-planet", "on the planet shaft: " + NOT_MADE[0])
-    b.joint("fixed", "needle", "rocker", "on the rocker: " + NOT_MADE[0])
-    return b.model()
+    b.joint("fixed", b.instance("rocker"), "shaft-planet", "on the planet shaft: " + NOT_MADE[0])
+    b.joint("fixed", b.instance("needle"), "rocker", "on the rocker: " + NOT_MADE[0])
+    return b.model(frame)
 
 
 def model_report(model: AssemblyModel, expected: int = 1) -> dict:

@@ -36,12 +36,11 @@ import re
 
 import numpy as np
 
-__all__ = ["ARM_PARTS", "arm_interference", "ground_clearance"]
+__all__ = ["arm_groups", "arm_interference", "ground_clearance"]
 
-#: Parts of one planting arm (instances carry ``-arm1`` / ``-arm2``); those absent from an
-#: assembly are skipped (no cam without a cuttable cam design, ...).
-ARM_PARTS = ("gearbox2-base", "gearbox2-cover", "shaft-D", "shaft-E", "cam",
-             "planter-shell", "blade-right", "blade-left")
+#: Part kinds enclosed by a housing of their own arm: not swept arm against arm (the housing
+#: around them is).
+_ENCLOSED_KINDS = frozenset({"gear"})
 #: The parts fixed in gearbox 2's body (the first group of :func:`_arm_part_bounds`).
 _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
 #: Gearbox 2's shafts, turning on their axes with their gears.
@@ -52,6 +51,23 @@ _GROUND_HOUSINGS = {"gearbox1": ("gearbox1-base", "gearbox1-cover"),
                     "gearbox2": ("gearbox2-base", "gearbox2-cover")}
 #: A housing half cut into segments to fit a printer: ``<half>-1``, ``<half>-2``, ...
 _SEGMENT = re.compile(r"-\d+$")
+
+
+def arm_groups(assembly) -> tuple[list, list]:
+    """Each planting arm's instances, as the assembly model places them: every part with one
+    copy per arm (two copies on one body, half a carrier turn apart), the gears inside
+    gearbox 2 left out (its housing stands for them). ``([arm 1's], [arm 2's])``, paired in
+    order; a part the clearance bounds do not know then fails loudly, not silently unswept."""
+    first, second = [], []
+    for part in assembly.parts:
+        copies = part.instances
+        if part.kind in _ENCLOSED_KINDS or len(copies) != 2:
+            continue
+        (one, body_one, phase_one), (two, body_two, phase_two) = copies
+        if body_one == body_two and math.isclose(abs(phase_two - phase_one), math.pi):
+            first.append(one)
+            second.append(two)
+    return first, second
 
 
 def _present(names, parts) -> list:
@@ -160,6 +176,18 @@ def _hinge(linkage, blade: str) -> np.ndarray:
     return np.array([-2.0 * linkage.L1 - linkage.hinge[0], linkage.hinge[1]])
 
 
+def _arm_bounds_of(instances, part_of, bounds) -> dict:
+    """Each arm instance's part's (speed, acceleration) bounds; a part without any (a new part
+    on the arm the bounds do not yet cover) is a SolidInputError naming it."""
+    from cadgen.solids.errors import SolidInputError
+
+    missing = sorted({part_of[name] for name in instances} - set(bounds))
+    if missing:
+        raise SolidInputError("arm_interference", f"no speed bound for the arm parts {missing}: "
+                              "cadgen.pipeline.clearances does not know how they move")
+    return {name: bounds[part_of[name]] for name in instances}
+
+
 def _verdict(result, target) -> str:
     """``fail`` when certainly not above ``target``, ``pass`` when certainly (or within the
     certified atol) above it, else ``undecided`` (the gap [bound, minimum] straddles it)."""
@@ -215,9 +243,10 @@ def arm_interference(params, mechanism, solids, cam, evaluation=None) -> dict:
 
     assembly = solids.assembly
     parts = {part.name: part for part in assembly.parts}
-    present = _present(ARM_PARTS, parts)
-    scene = FclScene(assembly, [f"{n}-arm1" for n in present], [f"{n}-arm2" for n in present])
+    arm1, arm2 = arm_groups(assembly)
+    scene = FclScene(assembly, arm1, arm2)
     bounds = _arm_part_bounds(mechanism, parts, cam)
+    part_of = {name: part.name for part in assembly.parts for name, _, _ in part.instances}
     # arm 2 moves like arm 1, half a turn on: each instance has its part's bounds, and the
     # distance repeats every half turn
     speed = max(value for value, _ in bounds.values())
@@ -225,8 +254,7 @@ def arm_interference(params, mechanism, solids, cam, evaluation=None) -> dict:
     result = certified_distance(scene, lipschitz=2 * speed, acceleration=2 * acceleration,
                                 upper=math.pi, atol=params.resolution.sweep_atol,
                                 steps=SWEEP_STEPS,
-                                instance_bounds={f"{name}-{arm}": bounds[name]
-                                                 for name in present for arm in ("arm1", "arm2")})
+                                instance_bounds=_arm_bounds_of(arm1 + arm2, part_of, bounds))
     kinematic = (_kinematic(evaluation, "arm_distance") if evaluation is not None
                  else _arm_distance_estimate(params, mechanism))
     return _section(result, "arm distance (solids, FCL)", params.targets.arm_distance_min,

@@ -32,6 +32,13 @@
       line.setAttribute("x1", view[0]); line.setAttribute("x2", view[0] + view[2]);
       line.setAttribute("y1", data.soil); line.setAttribute("y2", data.soil);
     }
+    // the machine's parts under everything else: each outline once, moved by its pose
+    var layer = data.parts || {outlines: {}, instances: []};
+    var parts = layer.instances.map(function (p) {
+      var el = shape(svg, "polygon", p.cls);
+      el.setAttribute("points", pairs(layer.outlines[p.part]));
+      return {el: el, frames: p.frames};
+    });
     data.static.forEach(function (s) { shape(svg, s.type, s.cls).setAttribute("points", pairs(s.points)); });
     var trails = data.trails.map(function (t) { return {el: shape(svg, "polyline", t.cls), points: t.points}; });
     var moving = data.moving.map(function (m) { return {el: shape(svg, m.type, m.cls), m: m}; });
@@ -53,6 +60,11 @@
         } else {
           item.el.setAttribute("points", pairs(f));
         }
+      });
+      parts.forEach(function (p) {
+        var i = 3 * k;
+        p.el.setAttribute("transform", "translate(" + p.frames[i] + "," + p.frames[i + 1] +
+                          ") rotate(" + p.frames[i + 2] + ")");
       });
       trails.forEach(function (t) { t.el.setAttribute("points", pairs(t.points.slice(0, 2 * (k + 1)))); });
       slider.value = k;

@@ -30,7 +30,7 @@ from kinematics.planar import perp as _perp, unit as _unit
 from cadgen.report.html_tables import _section
 
 __all__ = ["POSES", "animation_data", "planting_animation", "pricking_animation",
-           "animation_section", "placed"]
+           "animation_section", "placed", "parts_layer", "with_parts"]
 
 #: Poses per carrier turn (2 degrees apart).
 POSES = 180
@@ -150,6 +150,7 @@ def planting_animation(params, mechanism, evaluation=None, poses: int = POSES, *
         drawn.append(np.array([[0.0, events.soil_level]]))
     return {"kind": "planting", "poses": poses, "seconds": CYCLE_SECONDS,
             "angles": [round(float(a), 1) for a in np.degrees(phi)],
+
             "angle_label": "carrier angle from the catching position",
             "view": _bounds(*drawn), "soil": level, "static": static, "moving": moving,
             "trails": trails, "legend": legend}
@@ -201,11 +202,87 @@ def pricking_animation(design, field=None, poses: int = POSES, *, soil: bool = T
         drawn.append(np.array([[centre[0], first.surface_level]]))
     return {"kind": "pricking", "poses": poses, "seconds": CYCLE_SECONDS,
             "angles": [round(float(a), 1) for a in np.degrees(turn)],
+
             "angle_label": "carrier turn from the outer dead centre",
             "view": _bounds(*drawn), "soil": level,
             "static": [{"type": "polyline", "cls": "path arm1", "points": _xy(loop)}],
             "moving": moving, "trails": [{"cls": "trail arm1", "points": _xy(tip)}],
             "legend": legend}
+
+
+#: The parts' outlines are thinned to this (mm) for the page: far below a pixel at its scale.
+PART_OUTLINE_TOLERANCE = 0.1
+
+
+def _outline_of(part):
+    """A part's outline in the plane, in its own frame: a gear's or the cam's cut outline, a
+    housing half's flange outline; None for the parts drawn by the kinematics (the planter,
+    the blades, the rocker, the needle) or seen only edge-on (a shaft). A housing's cover has
+    its base's outline: only the base is drawn."""
+    if part.kind == "housing" and "-cover" in part.name:
+        return None
+    shape = part.outline if part.outline is not None else part.footprint
+    if shape is None:
+        return None
+    from shapely.geometry import LinearRing
+
+    ring = LinearRing(np.asarray(shape, dtype=float)).simplify(PART_OUTLINE_TOLERANCE)
+    return np.asarray(ring.coords, dtype=float)[:-1]
+
+
+def parts_layer(assembly, turns) -> dict | None:
+    """The machine's parts, placed by the assembly model at every pose: ``{"outlines": {part:
+    flat points in its own frame}, "instances": [{"part", "cls", "frames": [x, y, deg] per
+    pose]}}`` (SVG frame: y down, so a turn is clockwise), or None when no part has an outline.
+
+    Every instance the assembly model places is drawn where the solids are: the housings
+    (the frame's among them), the gears of both trains and the drive, the cam.
+    """
+    turns = [float(t) for t in turns]
+    assembly.prepare(turns)
+    outlines, instances = {}, []
+    for part in assembly.parts:
+        outline = _outline_of(part)
+        if outline is None:
+            continue
+        outlines[part.name] = _xy(outline)
+        for _, body, phase in part.instances or ((part.name, part.body, 0.0),):
+            frames = []
+            for turn in turns:
+                pose = assembly.body_pose(body, turn + phase) @ part.local(turn + phase)
+                frames += [round(float(pose[0, 3]), 1), round(float(-pose[1, 3]), 1),
+                           round(-math.degrees(math.atan2(pose[1, 0], pose[0, 0])), 2)]
+            instances.append({"part": part.name, "cls": f"part {part.kind}", "frames": frames})
+    return {"outlines": outlines, "instances": instances} if instances else None
+
+
+def _layer_points(layer, every: int = 15) -> np.ndarray:
+    """Points of the placed outlines at every ``every``-th pose (the view must hold them)."""
+    points = []
+    for instance in layer["instances"]:
+        local = np.asarray(layer["outlines"][instance["part"]], dtype=float).reshape(-1, 2)
+        frames = np.asarray(instance["frames"], dtype=float).reshape(-1, 3)
+        for x, y, deg in frames[::every]:
+            c, s_ = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+            placed = local @ np.array([[c, s_], [-s_, c]]) + (x, y)
+            points.append(placed * (1.0, -1.0))   # back to y up, as _bounds takes it
+    return np.vstack(points)
+
+
+def with_parts(data: dict, assembly) -> dict:
+    """The animation ``data`` with the machine's parts drawn under it, placed by ``assembly``
+    (its model's placements) at the animation's poses; the view grown to hold them."""
+    # the poses the animation samples: uniform in the carrier angle, as its own (both
+    # mechanisms' assemblies take the same angle from the same start)
+    layer = parts_layer(assembly, np.linspace(0.0, 2 * np.pi, data["poses"], endpoint=False))
+    if layer is None:
+        return data
+    view = data["view"]
+    corners = np.array([[view[0], -view[1]], [view[0] + view[2], -(view[1] + view[3])]])
+    data = dict(data, parts=layer, view=_bounds(corners, _layer_points(layer)))
+    data["legend"] = data["legend"] + [("part gear", "the machine's parts as the assembly "
+                                                    "model places them (housings, gears, cam)")]
+    return data
 
 
 def animation_data(params, values: dict, *, soil: bool = True) -> dict | None:
@@ -223,8 +300,13 @@ def animation_data(params, values: dict, *, soil: bool = True) -> dict | None:
     if "kinematics" not in values:
         return None
     if params.mechanism == "pricking":
-        return pricking_animation(values["kinematics"], values.get("metrics"), soil=soil)
-    return planting_animation(params, values["kinematics"], values.get("metrics"), soil=soil)
+        data = pricking_animation(values["kinematics"], values.get("metrics"), soil=soil)
+    else:
+        data = planting_animation(params, values["kinematics"], values.get("metrics"), soil=soil)
+    parts = values.get("parts")
+    if parts is not None and getattr(parts.assembly, "model", None) is not None:
+        data = with_parts(data, parts.assembly)
+    return data
 
 
 @functools.cache

@@ -160,6 +160,14 @@ def assemble_report(run, set_aside: dict) -> dict:
     if "drivetrain" in ok:
         report["machine"] = machine_section(params, values["drivetrain"],
                                             values["teeth"] if "teeth" in ok else None)
+        # the assembly model: the solids' (placed, with the bought items of their joints)
+        # when they were built, else the joint graph from the drivetrain records alone
+        from cadgen.assembly.machine import model_report
+
+        model = getattr(values["parts"].assembly, "model", None) if "parts" in ok else None
+        report["assembly"] = (assembly_section(params, values["drivetrain"],
+                                               values["teeth"] if "teeth" in ok else None)
+                              if model is None else model_report(model))
     if "parts" in ok:
         from cadgen.report.bom import bom_rows
         from cadgen.solids.outcome import solids_report
@@ -203,12 +211,12 @@ def machine_section(params, drivetrain, train=None) -> dict:
                      "where_mm": [list(map(float, point)) for point in rim.where],
                      "problems": [p.as_dict() for p in rim.problems]})
     section["hubs"] = rims
-    section["assembly"] = assembly_section(params, drivetrain, train)
     return section
 
 
 def assembly_section(params, drivetrain, train=None) -> dict:
-    """The joint graph (:mod:`cadgen.assembly.machine`): parts, joints, mobility, loose parts."""
+    """The joint graph (:mod:`cadgen.assembly.machine`) from the drivetrain records alone: parts,
+    joints, mobility, loose parts (no placements: no solids were built)."""
     from cadgen.assembly.machine import model_report, planting_model, pricking_model
 
     meshes = [tuple(stage.generated.pair.names) for stage in (train.stages if train else ())]

@@ -31,7 +31,7 @@ def machine_checks(report: dict) -> list:
              "its flank pressure"),
             ("shafts", not other, f"{len(shafts)} shafts sized" if not other
              else "; ".join(p["message"] for p in other))]
-    assembly = machine.get("assembly")
+    assembly = report.get("assembly")
     if assembly:
         rule = assembly["mobility_rule"]
         rows.append(("joint graph", bool(assembly.get("passed")),
@@ -126,7 +126,7 @@ def machine_section_html(report: dict) -> str:
             ["gear", "thinnest rim (mm)", "fails below (mm)", "warns below (mm)", "check"],
             rows, numeric=(1, 2, 3)))
     body.append(_transmission_html(report))
-    body.append(_joint_graph_html(machine.get("assembly")))
+    body.append(_joint_graph_html(report.get("assembly")))
     problems = machine.get("problems", [])
     if problems:
         body.append(_problem_list(problems))

@@ -86,23 +86,18 @@ def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: floa
                          passages=passages, tapped=tapped)
 
 
-def housing_parts(name: str, housing, body: str, instances=None) -> list:
-    """``[<name>-base, <name>-cover]`` parts of kind ``housing`` on ``body``.
-
-    ``instances`` is a function of the part name giving its instances (empty: one on
-    ``body``), as the gears' rule.
-    """
+def housing_parts(name: str, housing, body: str) -> list:
+    """``[<name>-base, <name>-cover]`` parts of kind ``housing`` on ``body`` (their copies are
+    the assembly model's to place)."""
     parts = []
     for piece, solid in (("base", housing.base), ("cover", housing.cover)):
         stem = f"{name}-{piece}"
         # seen along z a half is its flange's outline (the holes through it aside)
-        parts.append(Part(stem, "housing", body, solid,
-                          instances=instances(stem) if instances else (),
-                          footprint=housing.flange_outline))
+        parts.append(Part(stem, "housing", body, solid, footprint=housing.flange_outline))
     return parts
 
 
-def printed_housing_parts(name: str, housing, body: str, params, instances=None) -> tuple:
+def printed_housing_parts(name: str, housing, body: str, params) -> tuple:
     """A housing's parts, cut into segments when a printed half does not fit the printer.
 
     With ``[manufacturing] process = "printed"`` each half's printing pose
@@ -110,8 +105,7 @@ def printed_housing_parts(name: str, housing, body: str, params, instances=None)
     ``manufacturing.build_volume``; when one does not fit, the housing is cut across
     its long axis between its bearing seats (:mod:`cadgen.solids.segments`) and the
     parts are ``<name>-base-1``, ``<name>-base-2``, ..., ``<name>-cover-1``, ... (kind
-    ``housing`` on ``body``, ``instances`` applied to each stem as by
-    :func:`housing_parts`). Otherwise exactly :func:`housing_parts`.
+    ``housing`` on ``body``). Otherwise exactly :func:`housing_parts`.
 
     Returns
     -------
@@ -128,7 +122,7 @@ def printed_housing_parts(name: str, housing, body: str, params, instances=None)
 
     from cadgen.solids.outcome import fits_build_volume, printing_pose
 
-    parts = housing_parts(name, housing, body, instances)
+    parts = housing_parts(name, housing, body)
     if params.manufacturing.process != "printed":
         return parts, []
     volume = tuple(float(v) for v in params.manufacturing.build_volume)
@@ -149,8 +143,7 @@ def printed_housing_parts(name: str, housing, body: str, params, instances=None)
     for half in ("base", "cover"):
         for piece in split.pieces:
             stem = f"{name}-{half}-{piece.suffix}"
-            parts.append(Part(stem, "housing", body, getattr(piece, half),
-                              instances=instances(stem) if instances else ()))
+            parts.append(Part(stem, "housing", body, getattr(piece, half)))
     return parts, list(split.joints)
 
 
@@ -184,7 +177,7 @@ def _turn_of(transform) -> float:
     return math.atan2(transform[1, 0], transform[0, 0])
 
 
-def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=None) -> Part:
+def shaft_part(shaft, housing, body: str, *, segments: int, gears=None) -> Part:
     """The shaft of a :class:`~cadgen.machine.model.Shaft` record as a part on ``body``.
 
     Named ``shaft-<axis>``, kind ``shaft``, built along z at the origin and placed at
@@ -241,7 +234,7 @@ def shaft_part(shaft, housing, body: str, *, instances=(), segments: int, gears=
     else:   # the gears on one shaft turn together: the shaft turns with the first of them
         def local(phi, first=first, offset=offset):
             return planar_transform(_turn_of(first(phi)), offset)
-    return Part(f"shaft-{shaft.name}", "shaft", body, solid, local, tuple(instances))
+    return Part(f"shaft-{shaft.name}", "shaft", body, solid, local)
 
 
 def _hollow(solid, shaft, z_bottom: float, z_top: float, segments: int):

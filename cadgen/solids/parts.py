@@ -5,7 +5,9 @@ A :class:`Part` is a manifold3d solid in the frame of the rigid body it rides on
 transform that may depend on the pose, e.g. a gear turning on its shaft). A
 mechanism's :class:`Assembly` knows each body's world transform at any carrier
 angle and each part's local placement, so the same part meshes serve the STL
-files, the assembly file at a chosen angle, and (later) the collision sweep.
+files, the assembly file at a chosen angle and the collision sweeps. Which copies of
+a part exist (per arm, per side of carrier 1) is the assembly model's to say
+(:func:`placed_assembly`, :mod:`cadgen.assembly.machine`).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["Part", "Assembly", "planar_transform", "gear_solid"]
+__all__ = ["Part", "Assembly", "planar_transform", "gear_solid", "placed_assembly"]
 
 
 def planar_transform(angle: float = 0.0, offset=(0.0, 0.0), z: float = 0.0) -> np.ndarray:
@@ -86,6 +88,10 @@ class Assembly:
 
     parts: list
     body_pose: Callable
+    model: object = None   # the AssemblyModel whose placements the parts' instances are
+    #: ``angles -> None``: solve the poses of many carrier angles at once (a mechanism whose
+    #: pose needs an inverse solve); the default does nothing
+    prepare: Callable = field(default=lambda angles: None, repr=False)
 
     def placements(self, phi: float):
         """``[(instance name, part, 4x4 world transform)]`` at carrier angle ``phi`` (rad)."""
@@ -96,6 +102,25 @@ class Assembly:
                 pose = self.body_pose(body, phi + phase) @ part.local(phi + phase)
                 out.append((name, part, pose))
         return out
+
+
+def placed_assembly(parts, body_pose, build_model, drivetrain, train, housings) -> Assembly:
+    """The assembly of ``parts``, each placed as often and where the assembly model says.
+
+    ``build_model`` is :func:`cadgen.assembly.machine.planting_model` or
+    :func:`~cadgen.assembly.machine.pricking_model`: it is given every made part's body and
+    the housing records, and decides which copies exist (per arm, per side of carrier 1) and
+    what bought items their joints need. Each part's ``instances`` are then the model's
+    placements of it; a part the model does not know (the soil) stays one copy on its body.
+    """
+    meshes = [tuple(stage.generated.pair.names) for stage in (train.stages if train else ())]
+    model = build_model(drivetrain, meshes, bodies={part.name: part.body for part in parts},
+                        housings=housings)
+    for part in parts:
+        part.instances = model.instances_of(part.name)
+    for body in dict.fromkeys(p.body for p in model.placements):
+        body_pose(body, 0.0)   # a body the mechanism does not move is a KeyError here, not later
+    return Assembly(parts, body_pose, model)
 
 
 def gear_solid(profile, face_width: float, segments: int, path: str, chord_tolerance: float):

@@ -4,8 +4,12 @@ Frames. The mechanism plane is z = 0 of the world (x forward, y up), z towards
 the arms. Bodies and their poses at carrier angle ``phi`` (arm 2 is arm 1 at
 ``phi + pi``):
 
+``frame``
+    Fixed: the frame (the transmission box) and its input shaft and gears.
 ``carrier1``
-    Gearbox 1 and train 1's gears: turns by ``-phi`` about O (clockwise).
+    Gearbox 1 and train 1's gears (both sets), with shafts O and S seen from it:
+    turns by ``-phi`` about O (clockwise). Side 2 of the carrier is side 1's parts
+    turned half a turn about O (``carrier1:mirrored``).
 ``gearbox2``
     Origin at C, x along C->D->E (``gamma = phic + phi``): the housing, the four
     gears of the second train, and the cam (fixed to gearbox 2, coaxial with E).
@@ -28,9 +32,12 @@ Each housing is split at its parting plane into a base and a cover
 (:mod:`cadgen.solids.split_housing`) with the bearing seats bored in its end walls;
 each shaft is a part of its housing's body (:mod:`cadgen.solids.machine_parts`).
 
-Not modelled: train 1's second gear set (ratio -1/2, no sizes in the spec), the
-cam lever, push rod and blade links (their motion is in the cam report), the
-bearings themselves, keys and bolts.
+Each part is built once, in its body's frame; which copies exist (per arm, per
+side of carrier 1) and where they ride is the assembly model's to say
+(:mod:`cadgen.assembly.machine`, :func:`~cadgen.solids.parts.placed_assembly`).
+Not made as solids: the cam lever, push rod and blade links (their motion is in the
+cam report), and the bought items (bearings, keys, screws: on the model's joints,
+in the bill).
 """
 
 from __future__ import annotations
@@ -40,7 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
+from cadgen.solids.parts import Part, gear_solid, placed_assembly, planar_transform
 
 __all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius", "GEARLESS_KINDS"]
 
@@ -221,16 +228,8 @@ def _gear_parts(params, mechanism, train, layout, segments):
 
         solid, outline = gear_solid(profile, face, segments, path="gears.face_width",
                            chord_tolerance=params.gears.chord_tolerance)
-        instances = (((profile.file_stem + "-arm1", "gearbox2", 0.0),
-                      (profile.file_stem + "-arm2", "gearbox2", math.pi))
-                     if body == "gearbox2" else
-                     ((profile.file_stem, "frame", 0.0),) if body == "frame" else
-                     ((profile.file_stem + "-side1", "carrier1", 0.0),)
-                     if profile.name in ("sun", "sun I", "central shaft gear",
-                                         "transmission driven gear") else
-                     ((profile.file_stem + "-side1", "carrier1", 0.0),
-                      (profile.file_stem + "-side2", "carrier1:mirrored", 0.0)))
-        parts.append(Part(profile.file_stem, "gear", body, solid, local, instances, outline))
+        # its copies (per side of carrier 1, per arm) are placed by the assembly model
+        parts.append(Part(profile.file_stem, "gear", body, solid, local, outline=outline))
         frames[profile.name] = _in_carrier(body, local, start, float(
             profile.notes.get("keyway_angle_rad", 0.0)))
     return parts, frames
@@ -286,28 +285,21 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
                              drivetrain.seats("gearbox2"), z_cavity_bottom=layout.box2_floor,
                              segments=segments, path="housing.gearbox2", passages=passages2,
                              tapped=tapped2)
-    arms = lambda stem: ((f"{stem}-arm1", "gearbox2", 0.0), (f"{stem}-arm2", "gearbox2", math.pi))
     # a printed half too big for the printer comes in bolted segments; the splices stay on
     # the housing record (the bill of materials counts their bolts)
     parts1, joints1 = printed_housing_parts("gearbox1", housing1, "carrier1", params)
-    parts2, joints2 = printed_housing_parts("gearbox2", housing2, "gearbox2", params, arms)
+    parts2, joints2 = printed_housing_parts("gearbox2", housing2, "gearbox2", params)
     housing1 = replace(housing1, joints=tuple(joints1))
     housing2 = replace(housing2, joints=tuple(joints2))
     parts = parts1 + parts2
-    # the gears' instance rule: gearbox 1's axes on both sides of carrier 1 are side 1's part
-    # twice (the second half a turn on), gearbox 2's once per arm
-    sides = {(s.name, s.side) for s in drivetrain.shafts}
+    # one solid per shaft (side 1's, in its body's frame): the assembly model places its copies
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
-            parts.append(shaft_part(shaft, housing2, "gearbox2", instances=arms(f"shaft-{shaft.name}"),
-                                    segments=segments, gears=_frames_for(gears, "gearbox2")))
+            parts.append(shaft_part(shaft, housing2, "gearbox2", segments=segments,
+                                    gears=_frames_for(gears, "gearbox2")))
         elif shaft.housing == "gearbox1" and shaft.side == 1:
-            stem = f"shaft-{shaft.name}"
-            instances = ((f"{stem}-side1", "carrier1", 0.0),)
-            if (shaft.name, 2) in sides:
-                instances += ((f"{stem}-side2", "carrier1:mirrored", 0.0),)
-            parts.append(shaft_part(shaft, housing1, "carrier1", instances=instances,
-                                    segments=segments, gears=_frames_for(gears, "carrier1")))
+            parts.append(shaft_part(shaft, housing1, "carrier1", segments=segments,
+                                    gears=_frames_for(gears, "carrier1")))
     housings = (housing1, housing2)
     if "frame" in drivetrain.stacks:
         frame, frame_parts = _frame_parts(params, mechanism, drivetrain, layout, segments, gears)
@@ -353,9 +345,8 @@ def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
         if shaft.housing != "frame":
             continue
         body = "frame" if shaft.name == "input" else "carrier1"
-        stem = f"shaft-{shaft.name}"
-        parts.append(shaft_part(shaft, frame, body, instances=((stem, body, 0.0),),
-                                segments=segments, gears=_frames_for(gears, body)))
+        parts.append(shaft_part(shaft, frame, body, segments=segments,
+                                gears=_frames_for(gears, body)))
     return frame, parts
 
 
@@ -453,8 +444,7 @@ def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
     a, r = mechanism.centre_distance, mechanism.r
     attitude = float(mechanism.attitude(np.array([0.0]))[0])
     local0 = planar_transform(attitude - mechanism.phic, (a + 2 * r, 0.0))
-    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0,
-                (("cam-arm1", "gearbox2", 0.0), ("cam-arm2", "gearbox2", math.pi)), contour)
+    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour)
 
 
 def _planter_parts(params, cam_design, layout, segments):
@@ -510,12 +500,9 @@ def _planter_parts(params, cam_design, layout, segments):
 
     hinge_right = np.array([-L1 + e, hinge_y])
     hinge_left = np.array([-L1 - e, hinge_y])
-    arms = lambda stem: ((f"{stem}-arm1", "planter", 0.0), (f"{stem}-arm2", "planter", math.pi))
-    return [Part("planter-shell", "planter", "planter", shell, instances=arms("planter-shell")),
-            Part("blade-right", "blade", "planter", right, blade_local(1.0, hinge_right),
-                 arms("blade-right")),
-            Part("blade-left", "blade", "planter", left, blade_local(-1.0, hinge_left),
-                 arms("blade-left"))]
+    return [Part("planter-shell", "planter", "planter", shell),
+            Part("blade-right", "blade", "planter", right, blade_local(1.0, hinge_right)),
+            Part("blade-left", "blade", "planter", left, blade_local(-1.0, hinge_left))]
 
 
 def _stand_up(solid):
@@ -549,6 +536,7 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
     printed housing too big for the printer, ``gearbox1-base-1``, ... with the splices in
     the record's ``joints``).
     """
+    from cadgen.assembly.machine import planting_model
     from cadgen.solids.housings import housing_circles, planting_shells
     from cadgen.solids.ground import ground_part
 
@@ -586,4 +574,5 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
             return poses("carrier1", phi) @ planar_transform(math.pi)
         return poses(body, phi)
 
-    return Assembly(parts, pose), housings, layout
+    return placed_assembly(parts, pose, planting_model, drivetrain, train,
+                           dict(zip(("gearbox1", "gearbox2", "frame"), housings))), housings, layout

@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from cadgen.solids.parts import Assembly, Part, gear_solid, planar_transform
+from cadgen.solids.parts import Part, gear_solid, placed_assembly, planar_transform
 
 __all__ = ["pricking_assembly", "GEARLESS_KINDS"]
 
@@ -70,6 +70,8 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     """
     from kinematics.pricking_field import needle_geometry
 
+    from cadgen.assembly.machine import pricking_model
+
     from cadgen.solids.housings import ShellSize
     from dataclasses import replace
 
@@ -97,6 +99,14 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
         if angle not in poses:
             poses[angle] = _pose_parameters(design, angle)
         return poses[angle]
+
+    def prepare(angles):
+        # one vectorised inverse for many poses (the same values the scalar solve gives)
+        fresh = [float(a) for a in angles if float(a) not in poses]
+        if fresh:
+            first, phi1 = np.array([_carrier_angle(design, a) for a in fresh]).T
+            for angle, v, p in zip(fresh, motion.invert(first), phi1):
+                poses[angle] = (float(v), float(p))
 
     def carrier_pose(angle):
         # the case turns with the carrier: no inverse solve (the planet's pose needs one)
@@ -182,7 +192,10 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
         parts.append(_inclined_ground(
             params, field[0], (float(centre[0] - reach), float(centre[0] + reach)),
             (-floor, height + roof + wall + gap + 2 * params.linkage.needle_diameter), segments))
-    return Assembly(parts, body_pose), {"gear-case": case}
+    assembly = placed_assembly(parts, body_pose, pricking_model, drivetrain, train,
+                               {"gear-case": case})
+    assembly.prepare = prepare
+    return assembly, {"gear-case": case}
 
 
 def _inclined_ground(params, inclination, x_range, z_range, segments):
