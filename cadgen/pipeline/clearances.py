@@ -19,7 +19,12 @@ angle (see that module for the formula ``v + w * reach + u``):
   is smooth: cycloidal or 3-4-5), times its reach from the hinge, with the
   Coriolis term ``2 w beta'``; its reach from E is at most the hinge's distance
   from E plus that reach, however far it opens;
-* gearbox 1 (base and cover) turns about O at rate 1; the ground is fixed.
+* gearbox 1 (base and cover) turns about O at rate 1; the ground and the frame are fixed;
+  the pricking gear case and the sprocket under it turn about O at rate 1.
+
+Which instances are swept is read from the assembly model's placements (the copies on each
+arm; every housing, by the body it rides on), so a part the model adds is swept or refused
+with its name, never left out.
 
 Each part instance gets its own part's bounds (arm 2 moves like arm 1), and a pair
 of parts is certified with the sum of its two parts' (a cam against a planter shell
@@ -45,10 +50,6 @@ _ENCLOSED_KINDS = frozenset({"gear"})
 _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
 #: Gearbox 2's shafts, turning on their axes with their gears.
 _GEARBOX2_SHAFTS = ("shaft-D", "shaft-E")
-#: The housings kept clear of the ground: gearbox 1 (one instance) and gearbox 2 (per arm); the
-#: frame (fixed, below gearbox 1) too, when the assembly has it.
-_GROUND_HOUSINGS = {"gearbox1": ("gearbox1-base", "gearbox1-cover"),
-                    "gearbox2": ("gearbox2-base", "gearbox2-cover")}
 #: A housing half cut into segments to fit a printer: ``<half>-1``, ``<half>-2``, ...
 _SEGMENT = re.compile(r"-\d+$")
 
@@ -220,6 +221,22 @@ def _section(result, label, target, kinematic) -> dict:
     }
 
 
+def _housing_reach(part, body: str, rc: float) -> float:
+    """How fast (mm per rad of carrier angle) a point of a housing on ``body`` can move."""
+    from cadgen.sweep.scene import part_reach
+
+    if body == "frame":
+        return 0.0
+    if body == "carrier1":
+        return part_reach(part, axis=_Z)
+    if body == "gearbox2":
+        return rc + part_reach(part, axis=_Z)
+    from cadgen.solids.errors import SolidInputError
+
+    raise SolidInputError("ground_clearance", f"no speed bound for the housing {part.name!r} "
+                          f"on the body {body!r}")
+
+
 def _fixed_ground(reach: dict) -> dict:
     """Instance bounds of housings turning at rate 1 (speed and acceleration both their reach),
     and of the fixed ground."""
@@ -274,14 +291,17 @@ def ground_clearance(params, design, solids, field) -> dict:
     from cadgen.sweep.search import certified_distance
 
     assembly = solids.assembly
-    parts = {part.name: part for part in assembly.parts}
     if params.mechanism == "pricking":
         link = design.linkage
-        housings = _present(["gear-case-base", "gear-case-cover"], parts)
-        # the case turns about O at rate 1 (a point of it moves at most its reach from O)
+        # every housing the assembly model places (the gear case's halves, the frame bracket)
+        # and the sprocket under the case's floor: the case turns about O at rate 1 (a point
+        # of it moves at most its reach from O), the bracket is fixed
         centre = (*np.asarray(link.centre, dtype=float), 0.0)
-        reach = {name: part_reach(parts[name], body_origin_local=centre, axis=_Z)
-                 for name in housings}
+        reach = {name: (0.0 if body == "frame" else
+                        part_reach(part, body_origin_local=centre, axis=_Z))
+                 for part in assembly.parts if part.kind in ("housing", "sprocket")
+                 for name, body, _ in part.instances}
+        housings = list(reach)
         speed = max(reach.values())
         result = certified_distance(FclScene(assembly, housings, ["ground"]), lipschitz=speed,
                                     acceleration=speed, atol=params.resolution.sweep_atol,
@@ -289,18 +309,19 @@ def ground_clearance(params, design, solids, field) -> dict:
         # the case must stay out of the soil (no kinematic estimate for this mechanism)
         return _section(result, "gear case ground clearance (solids, FCL)", 0.0, None)
     rc = design.carrier_radii["C"]
-    box1 = _present(_GROUND_HOUSINGS["gearbox1"], parts)
-    box2 = _present(_GROUND_HOUSINGS["gearbox2"], parts)
-    frame = _present(("frame-base", "frame-cover"), parts)
-    housings = (list(box1) + [f"{name}-{arm}" for name in box2 for arm in ("arm1", "arm2")]
-                + list(frame))
-    # gearbox 1 turns about O at rate 1; gearbox 2 about C, which circles at rc (a point
-    # moves at most its reach, and accelerates at most the same, per radian)
-    reach = {name: part_reach(parts[name], axis=_Z) for name in box1}
-    reach.update({f"{name}-{arm}": rc + part_reach(parts[name], axis=_Z)
-                  for name in box2 for arm in ("arm1", "arm2")})
+    # every housing instance the assembly model places, bounded by the body it rides on:
+    # gearbox 1 turns about O at rate 1; gearbox 2 about C, which circles at rc (a point moves
+    # at most its reach, and accelerates at most the same, per radian); the frame is fixed
+    reach, frame = {}, []
+    for part in assembly.parts:
+        if part.kind != "housing":
+            continue
+        for name, body, _ in part.instances:
+            reach[name] = _housing_reach(part, body.split(":")[0], rc)
+            if body == "frame":
+                frame.append(name)
+    housings = list(reach)
     speed = max(reach.values())
-    reach.update({name: 0.0 for name in frame})   # the frame is fixed
     scene = FclScene(assembly, housings, ["ground"])
     result = certified_distance(scene, lipschitz=speed, acceleration=speed,
                                 atol=params.resolution.sweep_atol, steps=SWEEP_STEPS,
