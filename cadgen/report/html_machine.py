@@ -196,6 +196,19 @@ def _joint_graph_html(assembly) -> str:
     loose = assembly.get("unconnected") or []
     body = ("<h3>Joint graph</h3><p>" + _pass_badge(assembly.get("passed")) + " " + _e(text)
             + (_e("; held by nothing: " + ", ".join(loose)) if loose else "") + "</p>")
+    joints = assembly.get("joints") or []
+    if joints:
+        def bought(joint):   # the same item twice on one joint (two seats) is said once
+            counts = {}
+            for item in joint.get("items", []):
+                counts[item["description"]] = counts.get(item["description"], 0) + item["count"]
+            return "; ".join(f"{n} x {what}" for what, n in counts.items()) or "—"
+
+        rows = [[_e(j["kind"]), _e(j["a"]), _e(j["b"]), _e(j.get("detail", "")), _e(bought(j))]
+                for j in joints]
+        body += (f"<details><summary>every joint and what it is bought with ({len(joints)})"
+                 "</summary>" + _table(["kind", "part", "held by", "what makes it",
+                                        "bought items"], rows) + "</details>")
     not_made = assembly.get("not_made") or []
     if not_made:
         body += ("<details><summary>joints in the graph not yet made as parts "
