@@ -206,3 +206,13 @@ def test_the_arms_swept_against_each_other_are_the_models_arm_copies(paper_assem
     bounds = {name: (1.0, 1.0) for name in expected if name != "shaft-E"}
     with pytest.raises(SolidInputError, match=r"\['shaft-E'\]"):
         _arm_bounds_of(arm1 + arm2, part_of, bounds)
+
+
+def test_the_reports_joint_table_says_each_item_once_with_its_count():
+    from cadgen.assembly.machine import model_report
+    from cadgen.report.html_machine import _joint_graph_html
+
+    html = _joint_graph_html(model_report(small_machine()))
+    # the shaft's two seats' bearings are one line of two; the keys one each
+    assert "2 x deep-groove ball bearing 6002-2Z (15 x 32 x 9 mm)" in html
+    assert html.count("1 x parallel key DIN 6885 A 5 x 5 x 20") == 2
