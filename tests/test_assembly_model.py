@@ -135,6 +135,9 @@ def test_the_bills_bearings_and_keys_by_hand_from_the_placed_solids(paper_assemb
                 elif mount.key is not None:
                     keys += 1
             keys += record.coupling_key is not None   # the input's stub
+    # the planter's keyed hub on each arm's shaft E
+    keys += sum(name.startswith("planter-shell") for name in instances)
+    assert machine.fixings["planter"]["key"] is not None
     rows = _bought_rows(assembly.model, set(instances))
     assert sum(r["quantity"] for r in rows if r["part"] == "bearing") == bearings
     assert sum(r["quantity"] for r in rows if r["part"] == "key") == keys

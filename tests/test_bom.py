@@ -110,6 +110,11 @@ def test_bolts_nuts_and_washers_match_the_holes_in_the_flanges(built):
         bottom = float(trimesh.load(path).bounds[0, 2])
         holes["M6"] += _bolt_holes(path, bottom + 1.0, 5.0) * _instances(scene, f"{housing}-base")
     assert holes["M6"] == 6 + 2 * 6      # 6 screws on S, 6 on each arm's C
+    # the cam's screws, tapped into gearbox 2's cover roof (an M3 tap drill, 2.5 mm, ISO 2306):
+    # the cover lies on its roof (its largest flat face); cut 1 mm above the bottom
+    path = folder / "solids" / "gearbox2-cover.stl"
+    bottom = float(trimesh.load(path).bounds[0, 2])
+    holes["M3"] += _bolt_holes(path, bottom + 1.0, 2.5) * _instances(scene, "gearbox2-cover")
     assert screws == holes
     nuts = Counter(r["designation"].split()[2] for r in rows if r["part"] == "hexagon nut"
                    for _ in range(int(r["quantity"])))
@@ -125,7 +130,10 @@ def test_keys_one_per_keyed_gear_placed(built):
     # and the input shaft's stub, keyed for the sprocket or coupling
     couplings = [s for s in result.report["machine"]["shafts"] if s["coupling_key"]]
     assert [s["name"] for s in couplings] == ["input"]
-    assert sum(int(r["quantity"]) for r in rows if r["part"] == "key") == expected + 1 > 1
+    # and the planter's hub on shaft E, on each arm
+    assert result.report["machine"]["fixings"]["planter"]["key"] is not None
+    hubs = _instances(scene, "planter-shell")
+    assert sum(int(r["quantity"]) for r in rows if r["part"] == "key") == expected + 1 + hubs > 3
 
 
 def test_each_gear_sits_on_its_shaft_axis(built):

@@ -255,8 +255,11 @@ def test_planting_names_positions_and_stack():
     top = train.bases["gearbox2"] + train.stacks["gearbox2"].cavity_height + \
         inner.seats[1].bearing.width
     assert inner.ends == pytest.approx((-inner.seats[0].bearing.width, top))
-    assert shaft.extends_above == pytest.approx(2 * params.housing.axial_gap + params.cam.thickness
-                                                + params.planter.arm_thickness)
+    # E reaches through the cam (seated on the roof), the gap and the planter's keyed hub
+    hub = train.fixings["planter"]
+    assert hub["length"] >= params.planter.arm_thickness
+    assert shaft.extends_above == pytest.approx(params.cam.thickness + params.housing.axial_gap
+                                                + hub["length"])
 
 
 def test_planting_speeds_follow_the_train():

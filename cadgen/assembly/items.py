@@ -56,12 +56,15 @@ def bolted_flange_items(thread: str, grip: float, bolts: int) -> tuple[Item, ...
             Item("plain washer", names["washer"], names["washer"], 2 * bolts))
 
 
-def screw_items(thread: str, clamped: float, count: int) -> tuple[Item, ...]:
+def screw_items(thread: str, clamped: float, count: int, length: float | None = None
+                ) -> tuple[Item, ...]:
     """``count`` socket head cap screws through ``clamped`` mm into a tapped hole: the shortest
-    ISO 4762 length that engages one and a half diameters of thread."""
+    ISO 4762 length that engages one and a half diameters of thread (or ``length``, chosen by
+    the fixing)."""
     from cadgen.machine.catalogue import screw_length
 
-    length = screw_length(thread, float(clamped) + 1.5 * float(thread.removeprefix("M")))
+    if length is None:
+        length = screw_length(thread, float(clamped) + 1.5 * float(thread.removeprefix("M")))
     screw = f"ISO 4762 {thread} x {length:g} - 8.8"
     return (Item("socket head cap screw", screw, screw, int(count)),)
 

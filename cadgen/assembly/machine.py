@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 import re
 
-from cadgen.assembly.graph import AssemblyModel, Joint, Placement
+from cadgen.assembly.graph import AssemblyModel, Item, Joint, Placement
 from cadgen.assembly.items import (bearing_item, bolted_flange_items, key_item, screw_items,
                                    sprocket_items)
 
@@ -202,12 +202,22 @@ def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> Asse
             if a and c and not any(j.kind == "gear" and {j.a, j.b} == {a, c} for j in b.joints):
                 b.joint("gear", a, c, f"mesh {drive} - {driven}")
     # on the arms: the cam on gearbox 2, the planter on shaft E, the blades on the planter
+    fixings = getattr(drivetrain, "fixings", {}) or {}
     for arm in (1, 2):
         copy = f"arm{arm}"
-        b.joint("fixed", b.instance("cam", copy), box2[arm],
-                "on gearbox 2's roof over E: " + NOT_MADE[0] + " (screws)")
+        cam = b.instance("cam", copy)
+        screwed = fixings.get("cam")
+        if screwed:   # seated on the cover's roof, screwed into it
+            cover = next(p for p in b.parts if p.startswith("gearbox2-cover") and p.endswith(copy))
+            b.joint("fixed", cam, cover, f"{screwed['bolts']} x {screwed['screw']} in counterbores",
+                    screw_items(screwed["bolt"], 0.0, int(screwed["bolts"]),
+                                length=screwed["screw_length"]))
+        else:
+            b.joint("fixed", cam, box2[arm], "on gearbox 2's roof over E: " + NOT_MADE[0]
+                    + " (screws)")
         planter = b.instance("planter-shell", copy)
-        b.joint("fixed", planter, f"shaft-E-{copy}", "on shaft E: " + NOT_MADE[0] + " (bore and key)")
+        b.joint("fixed", planter, f"shaft-E-{copy}", *_hub_joint(fixings.get("planter"),
+                                                                 "on shaft E"))
         for blade in ("blade-right", "blade-left"):
             me = b.instance(blade, copy)
             b.joint("revolute", me, planter, "hinge: " + NOT_MADE[0] + " (pin)")
@@ -247,9 +257,29 @@ def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> Asse
     for drive, driven in meshes:
         if drive in gears and driven in gears:
             b.joint("gear", gears[drive], gears[driven], f"mesh {drive} - {driven}")
-    b.joint("fixed", b.instance("rocker"), "shaft-planet", "on the planet shaft: " + NOT_MADE[0])
-    b.joint("fixed", b.instance("needle"), "rocker", "on the rocker: " + NOT_MADE[0])
+    fixings = getattr(drivetrain, "fixings", {}) or {}
+    b.joint("fixed", b.instance("rocker"), "shaft-planet",
+            *_hub_joint(fixings.get("rocker"), "on the planet shaft"))
+    clamp = fixings.get("needle")
+    if clamp:
+        b.joint("fixed", b.instance("needle"), "rocker",
+                f"in the holder at the rocker's end, clamped by {clamp['set_screw']}",
+                (Item("set screw", clamp["set_screw"], clamp["set_screw"], 1),))
+    else:
+        b.joint("fixed", b.instance("needle"), "rocker", "on the rocker: " + NOT_MADE[0])
     return b.model(frame)
+
+
+def _hub_joint(hub, where: str) -> tuple:
+    """``(detail, items)`` of a part keyed (or D-flatted) to its shaft by its hub
+    (:func:`cadgen.machine.fixings.keyed_hub`), or not yet made."""
+    if not hub:
+        return (f"{where}: " + NOT_MADE[0] + " (bore and key)", ())
+    if hub["key"] is None:
+        return (f"{where}: a {hub['length']:g} mm hub on a D-flat "
+                f"{hub['flat_depth']:g} mm deep", ())
+    return (f"{where}: a {hub['length']:g} mm hub, {hub['key'].designation}",
+            (key_item(hub["key"]),))
 
 
 def model_report(model: AssemblyModel, expected: int = 1) -> dict:

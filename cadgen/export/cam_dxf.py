@@ -23,17 +23,18 @@ CAM_CENTRE_MARK_HALF_LENGTH = 5.0
 
 
 def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius: float = 0.0,
-                  chord_tolerance: float = 0.005, label: str = "cam") -> DxfSummary:
+                  chord_tolerance: float = 0.005, label: str = "cam", holes=()) -> DxfSummary:
     """Write a plate cam as a DXF cutting file (mm), laid out like a gear file.
 
     ``contour`` (the working profile) on ``OUTLINE`` (the one closed cutting path), the bore
-    on ``BORE``; ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and
-    a 10-mm centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as
+    and the screws' clearance holes (``holes``: ``((x, y), radius)`` each) on ``BORE``;
+    ``pitch_curve`` (the roller centre's path, open) on ``CONSTRUCTION-PITCH`` and a 10-mm
+    centre mark at the origin on ``CONSTRUCTION-CENTRE``; otherwise as
     :func:`cadgen.export.dxf.write_gear_dxf`.
     """
     path = Path(path)
     data, outline, used = _cam_file(path, contour, pitch_curve, bore_radius, chord_tolerance,
-                                    label)
+                                    label, holes)
     write_bytes_atomic(path, data)
     area, perimeter = ring_measures(outline)
     return DxfSummary(path, len(outline), used, area, perimeter)
@@ -41,13 +42,14 @@ def write_cam_dxf(path: str | os.PathLike, contour, pitch_curve, *, bore_radius:
 
 def cam_dxf_bytes(contour, pitch_curve, *, bore_radius: float = 0.0,
                   chord_tolerance: float = 0.005, label: str = "cam",
-                  path: str | os.PathLike = "cam.dxf") -> bytes:
+                  path: str | os.PathLike = "cam.dxf", holes=()) -> bytes:
     """The bytes :func:`write_cam_dxf` writes (``path`` names the file in error messages
     only), for a build that makes them before its output folder exists."""
-    return _cam_file(Path(path), contour, pitch_curve, bore_radius, chord_tolerance, label)[0]
+    return _cam_file(Path(path), contour, pitch_curve, bore_radius, chord_tolerance, label,
+                     holes)[0]
 
 
-def _cam_file(path: Path, contour, pitch_curve, bore_radius, chord_tolerance, label):
+def _cam_file(path: Path, contour, pitch_curve, bore_radius, chord_tolerance, label, holes=()):
     """``(bytes, thinned outline, tolerance used)`` of a cam's DXF file."""
     tolerance = _check_tolerance(chord_tolerance)
     centre = np.zeros(2)
@@ -57,6 +59,9 @@ def _cam_file(path: Path, contour, pitch_curve, bore_radius, chord_tolerance, la
     outline, used = thin_outline(closed_points(contour), tolerance, centre, bore_radius)
     pitch, _ = thin_ring(closed_points(pitch_curve), tolerance)
     doc = _new_document()
-    _add_gear(doc.modelspace(), outline, pitch, centre, float(bore_radius),
+    msp = doc.modelspace()
+    _add_gear(msp, outline, pitch, centre, float(bore_radius),
               CAM_CENTRE_MARK_HALF_LENGTH / CENTRE_MARK_HALF_LENGTH_MODULES)
+    for (x, y), radius in holes:   # the screws' clearance holes, cut like the bore
+        msp.add_circle((float(x), float(y)), float(radius), dxfattribs={"layer": "BORE"})
     return _audited_bytes(doc, path), outline, used

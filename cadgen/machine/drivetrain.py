@@ -30,6 +30,7 @@ from cadgen.machine.bearings import journal_bore, select_bearing
 from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
 from cadgen.machine.fits import process_fits
 from cadgen.machine.fastening import coupling_key, flange_problems, free_bearing
+from cadgen.machine.fixings import arm_fixings, fixings_report
 from cadgen.machine.layouts import (HOLLOW_WALL_MIN, _mount_fields, carry_flange, planting_axes,
                                     pricking_axes)
 from cadgen.machine.model import BearingSeat, Drivetrain, GearMount, HousingStack, Shaft
@@ -368,7 +369,7 @@ def _shaft_problems(axis, sized, given, machine, both_sides) -> list:
     return problems
 
 
-def drivetrain(params, design) -> Drivetrain:
+def drivetrain(params, design, cam=None) -> Drivetrain:
     """Every shaft, bearing seat and housing stack of a mechanism, with the rules used.
 
     Parameters
@@ -378,6 +379,9 @@ def drivetrain(params, design) -> Drivetrain:
     design : kinematics.planting.PlantingMechanism or kinematics.pricking.PrickingDesign
         As :func:`cadgen.design.build_mechanism` or :func:`cadgen.design.pricking_design`
         give them.
+    cam : cadgen.cam.design.CamDesign, optional
+        The planting cam: its screws to gearbox 2 are sized round its contour
+        (:func:`cadgen.machine.fixings.arm_fixings`); without it the cam has no fixing.
 
     Returns
     -------
@@ -472,6 +476,8 @@ def drivetrain(params, design) -> Drivetrain:
                                 f"than the {DRIVE_SLEEVE_DIAMETER:g} mm the drive's driven gear "
                                 "was designed round"))
     problems += _cam_bore_problems(params, shafts)
+    shafts, fixings, found = arm_fixings(params, shafts, stacks, fits, cam)
+    problems += found
     held = None
     if params.mechanism == "pricking":
         held, found = _pricking_case_drive(params, design, shafts, loads)
@@ -503,7 +509,7 @@ def drivetrain(params, design) -> Drivetrain:
     if held is not None:
         rules["case_drive"] = held
     return Drivetrain(params.mechanism, tuple(shafts), stacks, fits.process, rules,
-                      tuple(problems), drive, base)
+                      tuple(problems), drive, base, fixings)
 
 
 # ------------------------------------------------------------------ report
@@ -583,5 +589,6 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
               for name, s in drivetrain.stacks.items()}
     return {"mechanism": drivetrain.mechanism, "process": drivetrain.process,
             "shafts": shafts, "bearings": seats, "stacks": stacks, "rules": drivetrain.rules,
+            "fixings": fixings_report(drivetrain.fixings),
             "problems": [p.as_dict() for p in drivetrain.problems],
             "passed": not drivetrain.problems}

@@ -143,7 +143,8 @@ def planting_axes(params, mechanism, drive=None) -> tuple:
     radii = mechanism.carrier_radii
 
     def planter_plane(walls, base):   # the planter plate's mid-plane above gearbox 2's roof
-        return (base["gearbox2"] + box2 + walls["gearbox2"][1]) + gap + cam + gap + arm / 2
+        # (the cam is seated on the roof, the planter turns a gap above it)
+        return (base["gearbox2"] + box2 + walls["gearbox2"][1]) + cam + gap + arm / 2
 
     stub = lambda d: STUB_DIAMETERS * d + STUB_EXTRA   # noqa: E731
     none = lambda d: 0.0   # noqa: E731
@@ -202,7 +203,7 @@ def planting_axes(params, mechanism, drive=None) -> tuple:
               False, False, none, 0.0, None),
         _Axis("E", "gearbox2", 1, (a + 2 * r, 0.0), loads["E"],
               (("planet gear E", layer2, face_c),), False, True, none,
-              gap + cam + gap + arm, planter_plane,
+              cam + gap + arm, planter_plane,
               "carries the planter; the cam, fixed to gearbox 2, is bored clear of it"),
     ]
     return axes, cavities, loads, bases, drive

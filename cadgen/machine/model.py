@@ -160,6 +160,9 @@ class Drivetrain:
     drive: object = None      # cadgen.gears.drive.DriveDesign of the frame's two pairs, or None
     bases: dict = field(default_factory=dict)   # housing -> z of its cavity floor (mm), in
     #                                              the first housing's frame
+    fixings: dict = field(default_factory=dict)   # part -> its fixing (machine.fixings):
+    #                                                 the planter's and rocker's keyed hubs,
+    #                                                 the cam's screws, the needle's clamp
 
     def seats(self, housing: str) -> list:
         """The bearing seats of one housing, every side; a seat two shafts' records share (the

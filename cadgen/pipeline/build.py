@@ -220,7 +220,9 @@ def _metrics(run):
 def _drivetrain(run):
     from cadgen.machine.drivetrain import drivetrain
 
-    return drivetrain(run.params, run.values["kinematics"])
+    # the cam (when it was designed) is screwed to gearbox 2 round its contour
+    cam = run.values.get("cam") if run.status("cam") == "ok" else None
+    return drivetrain(run.params, run.values["kinematics"], cam)
 
 
 def _teeth(run):

@@ -136,7 +136,7 @@ def _cam_file(run, path: Path) -> bytes:
         from cadgen.export.cam_dxf import cam_dxf_bytes
         from cadgen.export.train_sheet import CachedFiles
 
-        from cadgen.solids.planting import cam_bore_radius
+        from cadgen.solids.fixing_features import cam_bore_radius, cam_screw_holes
 
         params, design = run.params, run.values["cam"]
         points = params.cam.profile_points
@@ -144,18 +144,22 @@ def _cam_file(run, path: Path) -> bytes:
         if shafts is None:   # a scene with the cam alone: size the shafts here (milliseconds)
             from cadgen.machine.drivetrain import drivetrain
 
-            shafts = drivetrain(params, run.values["kinematics"])
+            shafts = drivetrain(params, run.values["kinematics"], design)
         contour = design.profile.working_profile(points)
         pitch = design.profile.pitch_curve(points)
         bore = cam_bore_radius(params, shafts)
+        # the screws' clearance holes, in the cam's frame (as the solid's)
+        mechanism = run.values["kinematics"]
+        holes = cam_screw_holes(shafts, float(mechanism.attitude(np.array([0.0]))[0])
+                                - mechanism.phic)
         tolerance = params.gears.chord_tolerance
         # the teeth's cache (a scene without teeth touches none)
         cache = getattr(run.values.get("teeth"), "cache", None)
         made["bytes"] = CachedFiles(cache, tolerance).get(
             ("cam dxf", np.asarray(contour, dtype=float), np.asarray(pitch, dtype=float),
-             float(bore)),
+             float(bore), tuple((tuple(c), r) for c, r in holes)),
             lambda: cam_dxf_bytes(contour, pitch, bore_radius=bore, chord_tolerance=tolerance,
-                                  path=path))
+                                  path=path, holes=holes))
     return made["bytes"]
 
 

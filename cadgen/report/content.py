@@ -275,6 +275,8 @@ def failures(report: dict) -> list:
         for problem in rim["problems"]:
             if problem["code"] in FAILING_RIM_PROBLEMS:
                 out.append(f"gear hub {rim['gear']}: [{problem['code']}] {problem['message']}")
+    for failure in report.get("solids", {}).get("overlaps", {}).get("failures", []):
+        out.append(f"parts overlap at the assembly pose: {failure}")
     for row in report.get("solids", {}).get("enclosure", []):
         if not row["gears_enclosed"]:
             out.append(f"{row['housing']} does not enclose its gears (margin "

@@ -169,6 +169,15 @@ def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
         ok = all(r.get("gears_enclosed", True) and r.get("axial_fit", True) for r in rows)
         checks.append(("housings enclose their gears", ok, _plural(len(rows), "housing")))
         covered += [f"{r['housing']} does not enclose" for r in rows]
+        overlaps = report["solids"].get("overlaps")
+        if overlaps:
+            bad = overlaps.get("failures", [])
+            checks.append(("no parts overlap", not bad,
+                           "; ".join(bad) if bad else
+                           f"{overlaps['pairs_examined']} touching pairs intersected at "
+                           f"{_number(overlaps['carrier_angle_deg'], trim=True)} deg: only "
+                           "their fits' chord-error shells"))
+            covered.append("parts overlap at the assembly pose")
     if "stages" in report:
         bad = [f"{s['stage']} {s.get('status')}" for s in report["stages"]
                if s.get("status", "ok") != "ok"]

@@ -126,6 +126,7 @@ def machine_section_html(report: dict) -> str:
             ["gear", "thinnest rim (mm)", "fails below (mm)", "warns below (mm)", "check"],
             rows, numeric=(1, 2, 3)))
     body.append(_transmission_html(report))
+    body.append(_fixings_html(machine.get("fixings") or {}))
     body.append(_joint_graph_html(report.get("assembly")))
     problems = machine.get("problems", [])
     if problems:
@@ -182,6 +183,42 @@ def _transmission_html(report: dict) -> str:
             f"{_number(sprocket['torque_nm'], 1)} N·m at {_number(sprocket['speed_rpm'], 1)} "
             f"r/min, a chain pull of {_number(sprocket['chain_pull_n'], 0)} N") + "</p>")
     return "".join(out)
+
+
+def _fixings_html(fixings: dict) -> str:
+    """How the arm's parts are fixed: the keyed hubs (key, hub, flank pressure), the cam's
+    screws (circle, counterbores, shear), the needle's clamp."""
+    rows = []
+    for name, fix in fixings.items():
+        if "shaft" in fix:   # a keyed hub
+            key = fix.get("key")
+            what = (f"{key['designation']} in a {_number(fix['length'], trim=True)} mm hub "
+                    f"(boss {_number(fix['outside'], trim=True)} mm) on shaft {fix['shaft']}"
+                    if key else f"a D-flat {_number(fix['flat_depth'])} mm deep on shaft "
+                                f"{fix['shaft']}")
+            check = ("not checked (a D-flat)" if fix.get("pressure_mpa") is None else
+                     f"{_number(fix['pressure_mpa'], 0)} MPa of {_number(fix['allowed_mpa'], 0)}"
+                     f" under {_number(fix['torque_nm'])} N m")
+            passed = fix.get("pressure_mpa") is None or fix["pressure_mpa"] <= fix["allowed_mpa"]
+        elif "bolt" in fix:   # a screwed plate
+            what = (f"{fix['bolts']} x {fix['screw']} on a "
+                    f"{_number(2 * fix['bolt_circle_radius'], 1)} mm circle, heads sunk in "
+                    f"{_number(fix['counterbore_diameter'], trim=True)} x "
+                    f"{_number(fix['counterbore_depth'], trim=True)} mm counterbores, into "
+                    f"{fix['carries']}'s cover")
+            check = (f"screws' shear {_number(fix['bolt_shear_mpa'], 0)} MPa of "
+                     f"{_number(fix['bolt_shear_allow_mpa'], 0)} under "
+                     f"{_number(fix['torque_nm'])} N m")
+            passed = fix["bolt_shear_mpa"] <= fix["bolt_shear_allow_mpa"]
+        else:   # the needle's clamp
+            what = (f"a {_number(fix['outside'])} mm holder, bore {_number(fix['bore'], 3)} mm, "
+                    f"{fix['set_screw']}")
+            check, passed = "slides to set its reach, then clamped", True
+        rows.append([_e(name), _e(what), _e(check), _badge("pass" if passed else "fail")])
+    if not rows:
+        return ""
+    return ("<h3>How the arm's parts are fixed</h3>"
+            + _table(["part", "fixing", "check", ""], rows))
 
 
 def _joint_graph_html(assembly) -> str:

@@ -22,6 +22,12 @@ segments
     joined by bolted splice lugs.
 machine_parts
     The drivetrain's records (:mod:`cadgen.machine`) as assembly parts: housings, shafts.
+fixing_features
+    The holes and bosses the fixings need: tapped holes, passages, the cam's screw holes,
+    a keyed hub's boss and bore.
+overlaps
+    :func:`~cadgen.solids.overlaps.overlap_check`: the parts sharing material at the
+    assembly pose, a joint's fit told from a collision by the overlap's thickness.
 mass
     :func:`mass_properties`: volume, area, mass, centre of mass, inertia (mm, kg).
 housings, ground, parts, planting, pricking, outcome

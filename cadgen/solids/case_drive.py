@@ -24,7 +24,7 @@ def sprocket_tapped_holes(held: dict, centre, floor_wall: float) -> tuple:
     """The tapped holes of the sprocket's screws in the case's floor, for
     :func:`~cadgen.solids.split_housing.split_housing` (two screw diameters deep, at most the
     floor less 2 mm)."""
-    from cadgen.solids.planting import TAP_DRILL
+    from cadgen.machine.fixings import TAP_DRILL
 
     sprocket = held["sprocket"]
     size = float(sprocket["bolt"].removeprefix("M"))

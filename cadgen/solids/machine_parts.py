@@ -177,7 +177,7 @@ def _turn_of(transform) -> float:
     return math.atan2(transform[1, 0], transform[0, 0])
 
 
-def shaft_part(shaft, housing, body: str, *, segments: int, gears=None) -> Part:
+def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=()) -> Part:
     """The shaft of a :class:`~cadgen.machine.model.Shaft` record as a part on ``body``.
 
     Named ``shaft-<axis>``, kind ``shaft``, built along z at the origin and placed at
@@ -191,22 +191,26 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None) -> Part:
     makes the shaft turn with its gears and puts each keyseat under its gear's keyway:
     the keyseats' relative angles are the gears' phasing on the shaft, which the workshop
     cuts into it. Without it the shaft is fixed in the body, keyseats towards +x.
+
+    ``hubs``: ``(name, z_bottom, z_top, key)`` of the other parts keyed to the shaft (the
+    planter on E, the rocker on the planet shaft; z in the body frame), each with its
+    placement and keyway in ``gears`` under ``name``: a keyseat centred on its hub.
     """
     from cadgen.solids.split_housing import shaft_solid
 
     z_bottom, z_top = shaft_ends(shaft, housing)
     gears = {name: value for name, value in (gears or {}).items()
-             if name in {mount.gear for mount in shaft.mounts}}
+             if name in {mount.gear for mount in shaft.mounts} | {hub[0] for hub in hubs}}
     # the shaft turns with its keyed gears (a gear running free on its bearings does not)
     first = next((gears[m.gear][0] for m in shaft.mounts
                   if m.gear in gears and getattr(m, "bearing", None) is None), None)
     frame0 = _turn_of(first(0.0)) if first is not None else 0.0
 
-    def direction(mount) -> float:
+    def direction(name: str) -> float:
         # the keyway's direction in the body at phi = 0, in the shaft's frame
-        if mount.gear not in gears:
+        if name not in gears:
             return 0.0
-        local, keyway = gears[mount.gear]
+        local, keyway = gears[name]
         return _turn_of(local(0.0)) + keyway - frame0
 
     keyseats, flat, flat_angle = [], 0.0, 0.0
@@ -215,9 +219,14 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None) -> Part:
             middle = housing.z_cavity_bottom + mount.z_bottom + mount.face_width / 2
             length = min(mount.key.length, mount.face_width)
             keyseats.append((middle - length / 2, middle + length / 2, mount.key.width,
-                             mount.key.shaft_depth, direction(mount)))
+                             mount.key.shaft_depth, direction(mount.gear)))
         if float(mount.flat_depth or 0.0) > flat:
-            flat, flat_angle = float(mount.flat_depth), direction(mount)
+            flat, flat_angle = float(mount.flat_depth), direction(mount.gear)
+    for name, z_low, z_high, key in hubs:   # a keyseat centred on each other keyed hub
+        if key is not None:
+            middle = 0.5 * (z_low + z_high)
+            keyseats.append((middle - key.length / 2, middle + key.length / 2, key.width,
+                             key.shaft_depth, direction(name)))
     coupling = getattr(shaft, "coupling_key", None)
     if coupling is not None:   # the stub's keyseat, centred on the stub below the floor
         stub_top = housing.z_cavity_bottom - housing.floor_wall

@@ -45,6 +45,7 @@ class SolidsOutcome:
     file_type: str
     build_volume: tuple = DEFAULT_BUILD_VOLUME   # mm (x, y, z), the printer's
     process: str = "machined"                    # [manufacturing] process: parts' materials
+    segments: int = 96                           # polygons per circle (the overlaps' chord)
     _poses: dict = field(default_factory=dict, repr=False)
     _printed: dict = field(default_factory=dict, repr=False)   # part name -> printing mesh
     _made: dict = field(default_factory=dict, repr=False)   # what once() computed, by key
@@ -76,7 +77,7 @@ def solids_outcome(params, assembly, housings) -> SolidsOutcome:
     return SolidsOutcome(assembly, housings, enclosure_checks(assembly, housings),
                          settings.assembly_carrier_angle_rad, settings.density_kg_m3,
                          settings.assembly_format, tuple(params.manufacturing.build_volume),
-                         params.manufacturing.process)
+                         params.manufacturing.process, settings.segments_per_circle)
 
 
 def _turn_onto(normal) -> np.ndarray:
@@ -276,6 +277,16 @@ def enclosure_checks(assembly, housings: dict) -> list:
     return results
 
 
+def _overlaps(outcome: SolidsOutcome, fits) -> dict:
+    """The parts sharing material at the assembly pose (:func:`cadgen.solids.overlaps.overlap_check`),
+    a joined pair allowed the process's designed interference (none where hubs slide on)."""
+    from cadgen.solids.overlaps import overlap_check
+
+    interference = max(0.0, -(fits.hub_offset or 0.0), -(fits.seat_offset or 0.0))
+    return overlap_check(outcome.assembly, outcome.carrier_angle, segments=outcome.segments,
+                         interference=interference)
+
+
 def solids_report(outcome: SolidsOutcome) -> dict:
     """Mass properties per part, the enclosure checks and the assembly's pose (report.json);
     computed once per outcome (a copy each call)."""
@@ -323,6 +334,7 @@ def _solids_report(outcome: SolidsOutcome) -> dict:
                          "carrier_angle_deg": float(np.degrees(outcome.carrier_angle)),
                          "units": "m" if outcome.file_type == "glb" else "mm"},
             "enclosure": outcome.enclosure,
+            "overlaps": _overlaps(outcome, materials),
             "build_volume_mm": [float(v) for v in outcome.build_volume],
             "too_big_for_build_volume": too_big,
             "frames": "each STL in its printing pose: largest flat face down on z = 0, centred "

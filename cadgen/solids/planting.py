@@ -47,6 +47,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cadgen.machine.fastening import bolt_circle
+from cadgen.solids.fixing_features import (cam_bore_radius, cam_screw_holes, floor_holes,
+                                           keyed_boss, mounting_holes)
 from cadgen.solids.parts import Part, gear_solid, placed_assembly, planar_transform
 
 __all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius", "GEARLESS_KINDS"]
@@ -112,8 +115,9 @@ class PlantingLayout:
 def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayout:
     """The axial stack from the drivetrain's housing stacks: end walls, cavities, gear layers.
 
-    Gearbox 1's cavity floor is at z = 0; gearbox 2's floor wall starts ``gap`` above
-    gearbox 1's roof's outer face, the cam ``gap`` above gearbox 2's roof's.
+    Gearbox 1's cavity floor is at z = 0; gearbox 2's floor wall starts above gearbox 1's
+    roof's outer face (the carrying flange between, a gap each side); the cam is seated on
+    gearbox 2's roof (screwed to it), the planter's plate ``gap`` above the cam.
     """
     gap = params.housing.axial_gap
     face_nc = params.gears.face_width_for(mechanism.module(params.pitch_curve.teeth))
@@ -123,7 +127,7 @@ def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayo
     walls = (stack1.floor_wall, stack1.roof_wall, stack2.floor_wall, stack2.roof_wall)
     box1_height, box2_height = stack1.cavity_height, stack2.cavity_height
     box2_floor = drivetrain.bases.get("gearbox2", box1_height + walls[1] + gap + walls[2])
-    cam_bottom = box2_floor + box2_height + walls[3] + gap
+    cam_bottom = box2_floor + box2_height + walls[3]
     cam_thickness = params.cam.thickness if cam_design is not None else 0.0
     arm_bottom = cam_bottom + cam_thickness + gap
     arm_thickness = params.planter.arm_thickness
@@ -277,6 +281,10 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     holes = floor_holes(drivetrain)
     passages1, tapped1 = holes.get("gearbox1", ((), ()))
     passages2, tapped2 = holes.get("gearbox2", ((), ()))
+    screwed = drivetrain.fixings.get("cam")
+    if screwed:   # the cam's screws, tapped into the cover's roof round E
+        tapped2 += tuple((x, y, screwed["tap_drill"], screwed["tapped_depth"], "roof")
+                         for x, y in bolt_circle(screwed, (a + 2 * r, 0.0)))
     housing1 = stack_housing(params, discs1, box1, drivetrain.stacks["gearbox1"],
                              drivetrain.seats("gearbox1"), z_cavity_bottom=layout.box1_floor,
                              segments=segments, path="housing.gearbox1", passages=passages1,
@@ -293,10 +301,14 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     housing2 = replace(housing2, joints=tuple(joints2))
     parts = parts1 + parts2
     # one solid per shaft (side 1's, in its body's frame): the assembly model places its copies
+    hub = drivetrain.fixings.get("planter")
+    planter_hub = (("planter", layout.arm_bottom, layout.arm_bottom + hub["length"], hub["key"]),
+                   ) if hub else ()
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
             parts.append(shaft_part(shaft, housing2, "gearbox2", segments=segments,
-                                    gears=_frames_for(gears, "gearbox2")))
+                                    gears=_frames_for(gears, "gearbox2"),
+                                    hubs=planter_hub if shaft.name == "E" else ()))
         elif shaft.housing == "gearbox1" and shaft.side == 1:
             parts.append(shaft_part(shaft, housing1, "carrier1", segments=segments,
                                     gears=_frames_for(gears, "carrier1")))
@@ -308,8 +320,6 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     return parts, housings
 
 
-#: A tapped hole's drill for the carrying flanges' screws (ISO 2306, M6: 5.0 mm).
-TAP_DRILL = {"M5": 4.2, "M6": 5.0, "M8": 6.8}
 
 
 def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
@@ -350,83 +360,6 @@ def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
     return frame, parts
 
 
-#: The frame's mounting to the transplanter: tapped holes in its floor, from below.
-FRAME_MOUNT_BOLT, FRAME_MOUNT_HOLES = "M8", 4
-
-
-def mounting_holes(discs, shell, seats, floor_wall: float, segments: int) -> tuple:
-    """The frame's mounting holes: ``FRAME_MOUNT_HOLES`` tapped ``FRAME_MOUNT_BOLT`` holes in its
-    floor, as far apart as the floor allows (the corners of its outline less the side wall and
-    1.5 bolt diameters), each clear of the floor's bearing seats by a bolt diameter, two bolt
-    diameters deep (at most the floor less 2 mm): the transplanter's frame bolts up into them."""
-    import shapely
-
-    from cadgen.solids.shell import shell_outlines
-
-    size = float(FRAME_MOUNT_BOLT.removeprefix("M"))
-    _, outer = shell_outlines(discs, clearance=shell.clearance, wall=shell.wall,
-                              segments=segments)
-    inner = shapely.Polygon(outer).buffer(-(shell.wall + 1.5 * size))
-    ring = np.asarray(inner.exterior.coords)[:-1]
-    floor_seats = [(np.asarray(seat.xy, dtype=float), seat.seat_diameter / 2)
-                   for seat in seats if seat.wall == "floor"]
-    clear = [p for p in ring
-             if all(np.linalg.norm(p - xy) >= radius + size for xy, radius in floor_seats)]
-    chosen = []
-    for direction in ((1, 1), (-1, 1), (-1, -1), (1, -1))[:FRAME_MOUNT_HOLES]:
-        if clear:
-            best = max(clear, key=lambda p: float(np.dot(p, direction)))
-            if all(np.linalg.norm(best - q) > 2 * size for q in chosen):
-                chosen.append(best)
-    drill = TAP_DRILL[FRAME_MOUNT_BOLT]
-    depth = min(2.0 * size, floor_wall - 2.0)
-    return tuple((float(x), float(y), drill, depth, "floor") for x, y in chosen)
-
-
-def floor_holes(drivetrain) -> dict:
-    """``{housing: (passages, tapped)}``: the holes the seats do not make, for
-    :func:`~cadgen.solids.split_housing.split_housing`. A shaft passing a floor with no bearing
-    of its own (O through gearbox 1's, C2 through gearbox 2's) passes a hole of its diameter
-    plus the running clearance; the flange that carries a housing (the sleeve S carries gearbox
-    1, the hollow shaft C gearbox 2) is screwed into tapped holes of its floor, two screw
-    diameters deep (at most the floor less 2 mm), on the flange's bolt circle about the axis."""
-    from cadgen.machine.fastening import bolt_circle
-    from cadgen.machine.fits import process_fits
-
-    clearance = process_fits(drivetrain.process).running_clearance
-    floors = {name: stack.floor_wall for name, stack in drivetrain.stacks.items()}
-    out = {name: ([], []) for name in drivetrain.stacks}
-    for shaft in drivetrain.shafts:
-        if shaft.side != 1:
-            continue
-        passes = {"O": "gearbox1", "C2": "gearbox2"}.get(shaft.name)
-        if passes in out:
-            out[passes][0].append((0.0, 0.0, shaft.diameter + clearance, "floor"))
-        flange = shaft.flange
-        if flange and flange["carries"] in out:
-            size = float(flange["bolt"].removeprefix("M"))
-            depth = min(2.0 * size, floors[flange["carries"]] - 2.0)
-            drill = TAP_DRILL[flange["bolt"]]
-            out[flange["carries"]][1].extend((x, y, drill, depth, "floor")
-                                             for x, y in bolt_circle(flange))
-    return {name: (tuple(p), tuple(t)) for name, (p, t) in out.items()}
-
-
-def cam_bore_radius(params, drivetrain) -> float:
-    """The cam's bore radius (mm): the file's ``cam.bore_diameter`` when given, else E's shaft
-    running hole where it leaves gearbox 2's roof (E's shaft turns inside the cam, which is
-    fixed to gearbox 2); 0 (no bore) without a drivetrain and no value in the file."""
-    if params.cam.bore_diameter is not None:
-        return params.cam.bore_diameter / 2
-    if drivetrain is not None:
-        for shaft in drivetrain.shafts:
-            if shaft.name == "E":
-                for seat in shaft.seats:
-                    if seat.wall == "roof" and seat.through and seat.hole_diameter > 0:
-                        return seat.hole_diameter / 2
-    return 0.0
-
-
 def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
     from cadgen.geometry.contour import thinned_contour
     from cadgen.solids.extrude import extrude
@@ -434,21 +367,38 @@ def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
 
     points = params.cam.profile_points
     bore = cam_bore_radius(params, drivetrain)
+    # the cam's frame is the planter's at the catching pose; it is fixed to gearbox 2 at E
+    a, r = mechanism.centre_distance, mechanism.r
+    turn = float(mechanism.attitude(np.array([0.0]))[0]) - mechanism.phic
+    local0 = planar_transform(turn, (a + 2 * r, 0.0))
+    screws = cam_screw_holes(drivetrain, turn)
     holes = [circle(bore, segments)] if bore > 0 else []
+    holes += [circle(radius, segments, centre) for centre, radius in screws]
     # the contour cam.dxf holds, so the STL and the cutting file describe the same cam
     contour = thinned_contour(cam_design.profile.working_profile(points),
                               params.gears.chord_tolerance, bore_radius=bore)
-    solid = extrude(contour, params.cam.thickness, holes=holes,
+    thickness = params.cam.thickness
+    solid = extrude(contour, thickness, holes=holes,
                     z0=layout.cam_bottom, path="cam.thickness", outline_path="cam contour")
-    # the cam's frame is the planter's at the catching pose; it is fixed to gearbox 2 at E
-    a, r = mechanism.centre_distance, mechanism.r
-    attitude = float(mechanism.attitude(np.array([0.0]))[0])
-    local0 = planar_transform(attitude - mechanism.phic, (a + 2 * r, 0.0))
+    screwed = drivetrain.fixings.get("cam") if drivetrain is not None else None
+    if screwed:   # the screws' heads sunk in counterbores: the planter turns just above
+        from cadgen.solids.extrude import manifold3d_engine
+
+        m3d = manifold3d_engine()
+        depth, radius = screwed["counterbore_depth"], screwed["counterbore_diameter"] / 2
+        for centre, _ in screws:
+            solid = solid - m3d.Manifold.cylinder(depth + 1.0, radius, radius, segments).translate(
+                (centre[0], centre[1], layout.cam_bottom + thickness - depth))
     return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour)
 
 
-def _planter_parts(params, cam_design, layout, segments):
-    """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades."""
+def _planter_parts(params, cam_design, layout, segments, hub=None):
+    """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades.
+
+    ``hub`` (:func:`cadgen.machine.fixings.keyed_hub`, the drivetrain's ``fixings["planter"]``):
+    the plate's boss at E, up from the plate, and its bore with the keyway (towards the
+    planter's +x, where shaft E's keyseat is cut to meet it).
+    """
     from cadgen.solids.extrude import manifold3d_engine
 
     m3d = manifold3d_engine()
@@ -462,6 +412,8 @@ def _planter_parts(params, cam_design, layout, segments):
     plate = extrude(hull_of_circles([(0.0, 0.0, half), (-L1, 0.0, half)], segments),
                     layout.arm_thickness, z0=layout.arm_bottom, path="planter.arm_thickness",
                     outline_path="planter arm plate")
+    if hub:
+        plate = keyed_boss(plate, hub, layout.arm_bottom, segments)
     if cam_design is not None:
         linkage = cam_design.linkage
         lb, d0, hinge = linkage.blade_length, linkage.closed_half_angle, linkage.hinge
@@ -555,13 +507,19 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
     layout = layout_of(params, mechanism, shells, cam_design, drivetrain)
     gear_parts, frames = (_gear_parts(params, mechanism, train, layout, segments)
                           if train is not None and train.stages else ([], {}))
+    # the planter, keyed to shaft E like planet gear E: its keyway (+x in its frame) seen from
+    # gearbox 2, where E's keyseat is cut
+    start = body_poses(mechanism, layout)
+    frames["planter"] = {"gearbox2": (lambda phi: np.linalg.solve(start("gearbox2", phi),
+                                                                 start("planter", phi)), 0.0)}
     # the shafts turn with their gears, keyseats under the gears' keyways
     housing_parts, housings = _housing_parts(params, mechanism, circles, shells, layout, segments,
                                              drivetrain, frames)
     parts = housing_parts + gear_parts
     if cam_design is not None and cam_design.cuttable:
         parts.append(_cam_part(params, mechanism, cam_design, layout, segments, drivetrain))
-    parts += _planter_parts(params, cam_design, layout, segments)
+    parts += _planter_parts(params, cam_design, layout, segments,
+                            drivetrain.fixings.get("planter"))
     x_range = mechanism_extent(mechanism, circles)
     z_range = layout.z_range
     if soil_level is not None:

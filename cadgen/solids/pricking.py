@@ -178,20 +178,31 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     case_parts, joints = printed_housing_parts("gear-case", case, "case", params)
     case = replace(case, joints=tuple(joints))
     parts[:0] = case_parts
-    # the shafts turn with their gears, keyseats under the gears' keyways
-    shafts = [shaft_part(shaft, case, "case", segments=segments, gears=frames)
+    # the shafts turn with their gears, keyseats under the gears' keyways; the planet shaft's
+    # under the rocker's too (its keyway towards +x of the planet's frame, seen from the case)
+    hub = drivetrain.fixings.get("rocker")
+    rocker_z = height + roof + gap
+    frames["rocker"] = (lambda angle: np.linalg.solve(body_pose("case", angle),
+                                                      body_pose("planet", angle)), 0.0)
+    shafts = [shaft_part(shaft, case, "case", segments=segments, gears=frames,
+                         hubs=(("rocker", rocker_z, rocker_z + hub["length"], hub["key"]),)
+                         if hub and shaft.name == "planet" else ())
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
     parts += shafts
     if held:
         sun = next(s for s in drivetrain.shafts if s.name == "sun")
         sun_part = next(p for p in shafts if p.name == "shaft-sun")
         parts += case_drive_parts(held, sun, sun_part, centre, floor, gap, segments)
-    parts += _rocker_and_needle(params, link, needle, z0=height + roof + gap, segments=segments)
+    arm = _rocker_and_needle(params, link, needle, z0=rocker_z, segments=segments,
+                             hub=hub, clamp=drivetrain.fixings.get("needle"))
+    parts += arm
     if soil:
         reach = 2 * link.a + link.l + max(r for _, _, r in circles)
+        # the slab spans the machine along z: from under the case to above the needle's holder
+        z_top = max(float(part.solid.bounding_box()[5]) for part in arm) + wall
         parts.append(_inclined_ground(
             params, field[0], (float(centre[0] - reach), float(centre[0] + reach)),
-            (-floor, height + roof + wall + gap + 2 * params.linkage.needle_diameter), segments))
+            (-floor, z_top), segments))
     assembly = placed_assembly(parts, body_pose, pricking_model, drivetrain, train,
                                {"gear-case": case})
     assembly.prepare = prepare
@@ -213,26 +224,59 @@ def _inclined_ground(params, inclination, x_range, z_range, segments):
     return ground
 
 
-def _rocker_and_needle(params, link, needle, *, z0, segments):
-    """The rocker bar from B along +x (l1) and the needle from its end, perpendicular, to D."""
+def _rocker_and_needle(params, link, needle, *, z0, segments, hub=None, clamp=None):
+    """The rocker bar from B along +x (l1) and the needle from its end, perpendicular, to D.
+
+    With the drivetrain's fixings: the rocker's boss at B (``hub``, keyed to the planet shaft,
+    up from the bar, its keyway towards +x) and the needle's holder at the bar's end (``clamp``:
+    a sleeve along the needle on top of the bar, a tapped hole down through its wall for the
+    set screw); the needle then runs through the holder's bore from its back face. Without
+    them the needle is joined to the bar's end, as one body."""
     from cadgen.solids.extrude import manifold3d_engine
 
     m3d = manifold3d_engine()
 
     from cadgen.solids.extrude import extrude
     from cadgen.solids.outline import hull_of_circles
+    from cadgen.solids.fixing_features import keyed_boss
 
     linkage = params.linkage
     half = linkage.rocker_width / 2
-    rocker = extrude(hull_of_circles([(0.0, 0.0, half), (link.rocker, 0.0, half)], segments),
+    hub_radius = max(half, hub["outside"] / 2) if hub else half
+    rocker = extrude(hull_of_circles([(0.0, 0.0, hub_radius), (link.rocker, 0.0, half)],
+                                     segments),
                      linkage.rocker_thickness, z0=z0, path="linkage.rocker_thickness",
                      outline_path="rocker outline")
+    if hub:
+        rocker = keyed_boss(rocker, hub, z0, segments)
     radius = linkage.needle_diameter / 2
     cone = min(3 * linkage.needle_diameter, 0.5 * link.needle)
-    shaft = m3d.Manifold.cylinder(link.needle - cone, radius, radius, segments)
-    point = m3d.Manifold.cylinder(cone, radius, 0.0, segments).translate((0, 0, link.needle - cone))
-    # built along +z from the root; turn +z onto the needle's direction in the plane (+-y),
-    # and put its axis beside the rocker so the two overlap and join
+    top = z0 + linkage.rocker_thickness
+    if clamp:
+        # the holder: a sleeve along the needle (y), sunk 1 mm into the bar's top so they join
+        outside, width = clamp["outside"] / 2, linkage.rocker_width
+        axis_z = top + outside - 1.0
+        holder = _stand_along_y(m3d.Manifold.cylinder(width, outside, outside, segments),
+                                width).translate((link.rocker, 0.0, axis_z))
+        bore = _stand_along_y(m3d.Manifold.cylinder(width + 2.0, clamp["bore"] / 2,
+                                                    clamp["bore"] / 2, segments),
+                              width + 2.0).translate((link.rocker, 0.0, axis_z))
+        tap = m3d.Manifold.cylinder(outside + 1.0, clamp["tap_drill"] / 2, clamp["tap_drill"] / 2,
+                                    segments).translate((link.rocker, 0.0, axis_z))
+        rocker = rocker + holder - bore - tap
+        back = width / 2   # the needle enters the holder at its back face
+    else:
+        axis_z, back = z0 + linkage.rocker_thickness / 2, 0.0
+    length = link.needle + back
+    shaft = m3d.Manifold.cylinder(length - cone, radius, radius, segments)
+    point = m3d.Manifold.cylinder(cone, radius, 0.0, segments).translate((0, 0, length - cone))
+    # built along +z from its back end; turn +z onto the needle's direction in the plane (+-y),
+    # its back end behind the rocker's end by ``back``
     body = (shaft + point).rotate((-90.0 * needle.side, 0.0, 0.0))
-    body = body.translate((link.rocker, 0.0, z0 + linkage.rocker_thickness / 2))
+    body = body.translate((link.rocker, -needle.side * back, axis_z))
     return [Part("rocker", "rocker", "planet", rocker), Part("needle", "needle", "planet", body)]
+
+
+def _stand_along_y(solid, length: float):
+    """A solid built along +z from 0 to ``length``, turned to run along y, centred on y = 0."""
+    return solid.rotate((-90.0, 0.0, 0.0)).translate((0.0, -length / 2, 0.0))

@@ -1,0 +1,148 @@
+"""The arm parts' fixings (cadgen.machine.fixings) against hand sums and the DIN 6885 table, and
+the overlap check (cadgen.solids.overlaps) against boxes whose intersections are known."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cadgen.machine.catalogue import key_lengths, preferred_diameters
+from cadgen.machine.fixings import keyed_hub, needle_clamp, screwed_plate
+from cadgen.machine.shafts import key_for_shaft
+
+# ISO 898-1 Table: tensile stress areas of coarse threads (mm^2), the catalogue figures
+STRESS_AREA = {"M3": 5.03, "M4": 8.78, "M5": 14.2}
+
+
+def test_the_planters_hub_on_shaft_e_by_hand():
+    # T_E = 17.27 N m on a 15 mm shaft: DIN 6885 5 x 5 (t1 = 3); p = 2 T / (d (h - t1) (l - b))
+    torque = 17266.3
+    hub, problems = keyed_hub("planter", "E", 15.0, torque, 8.0, 150.0, 0.009, "planter")
+    assert problems == []
+    assert hub["key"].length == 14.0   # 12 mm: 2 T / (15 x 2 x 7) = 164 MPa, over 150
+    assert 2 * torque / (15 * 2 * (12 - 5)) > 150.0
+    assert hub["pressure_mpa"] == pytest.approx(2 * torque / (15 * 2 * (14 - 5)))
+    assert hub["length"] == 16.0 and hub["outside"] == 30.0   # the key plus 1 mm each end; 2 d
+
+
+def test_a_small_shaft_gets_a_d_flat_unchecked_and_an_overload_is_named():
+    hub, problems = keyed_hub("rocker", "planet", 8.0, 5000.0, 8.0, 150.0, 0.0, "linkage")
+    assert hub["key"] is None and hub["flat_depth"] == pytest.approx(0.8)
+    assert hub["pressure_mpa"] is None and problems == []
+    hub, problems = keyed_hub("planter", "E", 15.0, 17266.3, 8.0, 10.0, 0.0, "planter.x")
+    assert [p.code for p in problems] == ["key_overloaded"] and problems[0].path == "planter.x"
+    assert hub["key"].length <= 2.5 * 15 - 2   # the longest the largest hub takes
+
+
+@settings(max_examples=60, deadline=None)
+@given(d=st.sampled_from([d for d in preferred_diameters() if 10 <= d <= 60]),
+       torque=st.floats(1e3, 2e5), plate=st.floats(4.0, 30.0))
+def test_the_hubs_key_is_the_shortest_passing_standard_key(d, torque, plate):
+    hub, problems = keyed_hub("part", "shaft", d, torque, plate, 150.0, 0.0, "x")
+    key = hub["key"]
+    # brute force over the standard lengths: pressures from the table's own b, h, t1
+    row = key_for_shaft(d)
+
+    def pressure(length):
+        return 2 * torque / (d * (row.height - row.shaft_depth) * (length - row.width))
+
+    usable = [n for n in key_lengths() if n > row.width and n <= max(2.5 * d, plate) - 2]
+    passing = [n for n in usable if pressure(n) <= 150.0]
+    if not passing:
+        assert [p.code for p in problems] == ["key_overloaded"]
+        return
+    fits_plate = [n for n in key_lengths() if n <= plate - 2]
+    assert key.length == max(passing[0], fits_plate[-1] if fits_plate else 0)
+    assert problems == [] and hub["pressure_mpa"] <= 150.0 + 1e-9
+    assert hub["length"] == pytest.approx(max(plate, key.length + 2))
+
+
+def test_the_cams_screws_by_hand():
+    # an 8 mm cam round a 32 mm bearing seat: M3 heads (3 mm) sink 3.4 mm, leaving 4.6 mm >= 0.8 d
+    plate, problems = screwed_plate("cam", "gearbox2", 16.0, 8.0, 2733.0, 10.0, "cam.thickness")
+    assert problems == [] and plate["bolt"] == "M3" and plate["bolts"] == 3
+    assert plate["bolt_circle_radius"] == pytest.approx(16.0 + 2.0 + 2.5 / 2)   # tap drill 2.5
+    assert plate["counterbore_diameter"] == 6.5 and plate["counterbore_depth"] == pytest.approx(3.4)
+    # 4.6 clamped + 4.5 engaged = 9.1 mm: the next ISO 4762 M3 length is 10
+    assert plate["screw"] == "ISO 4762 M3 x 10 - 8.8"
+    shear = 2733.0 / (3 * STRESS_AREA["M3"] * plate["bolt_circle_radius"])
+    assert plate["bolt_shear_mpa"] == pytest.approx(shear, rel=0.01)
+    # a 5 mm plate cannot sink an M3, M4 or M5 head and keep 0.8 d under it
+    _, problems = screwed_plate("cam", "gearbox2", 16.0, 5.0, 2733.0, 10.0, "cam.thickness")
+    assert [p.code for p in problems] == ["plate_too_thin"]
+
+
+def test_the_needles_clamp():
+    clamp, problems = needle_clamp(8.0, 16.0, 0.06, "linkage.needle_diameter")
+    assert problems == [] and clamp["wall"] == 4.0 and clamp["outside"] == pytest.approx(16.06)
+    assert clamp["set_screw"] == "ISO 4027 M4 x 4 - 45H"
+
+
+# ------------------------------------------------------------------ the overlap check
+class _Part:
+    def __init__(self, name, solid, kind="housing"):
+        self.name, self.solid, self.kind = name, solid, kind
+
+
+class _Assembly:
+    def __init__(self, placed, model=None):
+        self._placed, self.model = placed, model
+
+    def placements(self, phi):
+        return [(part.name, part, pose) for part, pose in self._placed]
+
+
+def _box(x, y, z):
+    from cadgen.solids.extrude import manifold3d_engine
+
+    return manifold3d_engine().Manifold.cube((x, y, z))
+
+
+@settings(max_examples=25, deadline=None)
+@given(dx=st.floats(0.5, 9.5), dy=st.floats(0.5, 9.5), dz=st.floats(0.5, 9.5),
+       turn=st.floats(0, 2 * math.pi))
+def test_an_unjoined_overlap_fails_with_the_boxes_volume_and_thickness(dx, dy, dz, turn):
+    from cadgen.solids.overlaps import overlap_check
+    from cadgen.solids.parts import planar_transform
+
+    # two 10 mm cubes, the second moved by (dx, dy, dz): they share (10 - dx)(10 - dy)(10 - dz);
+    # both turned together about z (the overlap moves with them, its size does not)
+    turned = planar_transform(turn)
+    moved = turned @ planar_transform(0.0, (dx, dy), dz)
+    check = overlap_check(_Assembly([(_Part("a", _box(10, 10, 10)), turned),
+                                     (_Part("b", _box(10, 10, 10)), moved)]), segments=64)
+    a, b, c = 10 - dx, 10 - dy, 10 - dz
+    [overlap] = check["overlaps"]
+    assert overlap["volume_mm3"] == pytest.approx(a * b * c, rel=1e-6)
+    assert overlap["thickness_mm"] == pytest.approx(a * b * c / (a * b + b * c + c * a), rel=1e-6)
+    assert not check["passed"] and "a and b share" in check["failures"][0]
+
+
+def test_a_joined_shell_within_the_chord_error_passes_and_a_thick_one_does_not():
+    from cadgen.assembly import AssemblyModel, Joint
+    from cadgen.solids.extrude import manifold3d_engine
+    from cadgen.solids.overlaps import overlap_check
+
+    m3d = manifold3d_engine()
+    shaft = m3d.Manifold.cylinder(20.0, 7.5, 7.5, 64)
+    # a hub whose 64-gon bore, turned half a step, is cut by the shaft's corners
+    hub = (m3d.Manifold.cylinder(10.0, 15.0, 15.0, 64)
+           - m3d.Manifold.cylinder(10.0, 7.5, 7.5, 64).rotate((0, 0, 180 / 64)))
+    model = AssemblyModel(("shaft", "hub"), (Joint("fixed", "hub", "shaft"),), "shaft")
+    eye = np.eye(4)
+    check = overlap_check(_Assembly([(_Part("shaft", shaft, "shaft"), eye),
+                                     (_Part("hub", hub, "gear"), eye)], model), segments=64)
+    [overlap] = check["overlaps"]
+    assert overlap["joined"] and check["passed"]
+    assert overlap["thickness_mm"] <= 7.5 * (1 - math.cos(math.pi / 64))
+    # the same pair not joined by the model: the sliver is a defect
+    loose = overlap_check(_Assembly([(_Part("shaft", shaft, "shaft"), eye),
+                                     (_Part("hub", hub, "gear"), eye)]), segments=64)
+    assert not loose["passed"]
+    # a hub with no bore on the joined shaft: millimetres thick, fails
+    solid = overlap_check(_Assembly([(_Part("shaft", shaft, "shaft"), eye),
+                                     (_Part("hub", m3d.Manifold.cylinder(10.0, 15.0, 15.0, 64),
+                                            "gear"), eye)], model), segments=64)
+    assert not solid["passed"] and solid["overlaps"][0]["thickness_mm"] > 1.0
