@@ -29,8 +29,9 @@ def test_writes_report_and_plots(params, tmp_path):
                  "central-shaft-gear", "input-gear-2", "transmission-driven-gear")
     assert dxf == sorted(["central.dxf", "gear-D.dxf", "idler-1.dxf", "idler-2.dxf",
                           "intermediate.dxf", "planet-gear-E.dxf", "sun.dxf", "train-1-planet.dxf",
-                          "train.dxf", *(f"{gear}.dxf" for gear in new_gears)])
+                          *(f"{gear}.dxf" for gear in new_gears)])
     assert (folder / "cam.dxf").is_file()
+    assert sorted(p.name for p in (folder / "drawings").iterdir()) == ["cam.dxf", "train.dxf"]
     solids = sorted(p.name for p in (folder / "solids").iterdir())
     assert solids == sorted(["assembly.glb", "blade-left.stl", "blade-right.stl", "cam.stl",
                              "central.stl", "gear-D.stl", "gearbox1-base.stl",

@@ -248,9 +248,11 @@ def test_dxf_asked_alone_writes_the_gears_as_the_teeth_effect_cuts_them(params, 
     alone = build(params, tmp_path / "alone", effects=["dxf"], cache=False)
     with_teeth = build(params, tmp_path / "teeth", effects=["teeth", "dxf"], cache=False)
     files = {p.name: p.read_bytes() for p in (alone.output_dir / "gears").iterdir()}
-    assert len(files) == 16 + 1 and "train.dxf" in files    # every gear and the train sheet
+    assert len(files) == 16    # every gear's cutting file; the train sheet is a drawing
     assert files == {p.name: p.read_bytes() for p in (with_teeth.output_dir / "gears").iterdir()}
     assert (alone.output_dir / "cam.dxf").is_file()
+    drawings = sorted(p.name for p in (alone.output_dir / "drawings").iterdir())
+    assert drawings == ["cam.dxf", "train.dxf"]
 
 
 def test_two_processes_write_the_same_bytes_whatever_their_string_hashing(tmp_path):

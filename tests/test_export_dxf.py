@@ -146,12 +146,14 @@ def test_round_trip_layers_entities_units(tmp_path, name, star, bay):
     assert not auditor.has_errors and not auditor.has_fixes
     assert doc.units == ezdxf.units.MM
     assert doc.header["$INSUNITS"] == ezdxf.units.MM and doc.header["$MEASUREMENT"] == 1
-    for layer, colour in export_dxf.LAYERS.items():
+    # a cutting file: its layers are the cutting layers, nothing a CAM program could take for
+    # a path besides them
+    assert {layer.dxf.name for layer in doc.layers} - {"0", "Defpoints"} == set(CUTTING_LAYERS)
+    for layer, colour in CUTTING_LAYERS.items():
         assert doc.layers.get(layer).dxf.color == colour
 
     (outline,) = _entities(doc, "OUTLINE", "LWPOLYLINE")
-    (pitch,) = _entities(doc, PITCH_LAYER, "LWPOLYLINE")
-    assert outline.closed and not pitch.closed  # construction: an open curve, never a cutting loop
+    assert outline.closed
     points = np.array(outline.get_points(format="xy"))
     assert len(points) == summary.outline_points_written
     assert not np.array_equal(points[0], points[-1])  # closed by the flag, not by a repeated point
@@ -163,18 +165,27 @@ def test_round_trip_layers_entities_units(tmp_path, name, star, bay):
     (bore,) = _entities(doc, "BORE", "CIRCLE")
     assert bore.dxf.radius == pytest.approx(profile.bore_radius)
     assert np.allclose(_xy(bore.dxf.center), profile.centre)
+    # Nothing else in the file: the pitch curve and the centre mark are the train sheet's
+    assert len(doc.modelspace()) == 2
 
-    lines = _entities(doc, CENTRE_LAYER, "LINE")
+    # the same gear on a sheet (a drawing): its pitch curve open construction, its centre mark
+    sheet = tmp_path / "sheet.dxf"
+    write_train_sheet(sheet, [(profile, 0.0, (0.0, 0.0))], chord_tolerance=0.005)
+    drawing = ezdxf.readfile(sheet)
+    for layer, colour in export_dxf.LAYERS.items():
+        assert drawing.layers.get(layer).dxf.color == colour
+    (pitch,) = _entities(drawing, PITCH_LAYER, "LWPOLYLINE")
+    assert not pitch.closed  # construction: an open curve, never a cutting loop
+    lines = _entities(drawing, CENTRE_LAYER, "LINE")
     assert len(lines) == 2
     directions = []
     for line in lines:
         start, end = _xy(line.dxf.start), _xy(line.dxf.end)
         assert np.linalg.norm(end - start) == pytest.approx(2.0 * profile.module)
-        assert np.allclose((start + end) / 2.0, profile.centre)  # crossing at the centre
         directions.append((end - start) / np.linalg.norm(end - start))
     assert abs(np.dot(*directions)) < 1e-12  # perpendicular
-    # Nothing else in the drawing.
-    assert len(doc.modelspace()) == 5
+    middles = [(_xy(line.dxf.start) + _xy(line.dxf.end)) / 2 for line in lines]
+    assert np.allclose(middles[0], middles[1])   # crossing at the (placed) centre
 
 
 def test_no_bore_no_circle(tmp_path, star):
@@ -434,7 +445,10 @@ def test_train_sheet_bad_placements(tmp_path, star):
 
 PLANTING_FILES = ["central", "intermediate", "gear-D", "planet-gear-E", "sun", "idler-1", "idler-2",
                   "train-1-planet", "sun-I", "idler-1-I", "idler-2-I", "planet-I", "input-gear-1",
-                  "central-shaft-gear", "input-gear-2", "transmission-driven-gear", "train", "cam"]
+                  "central-shaft-gear", "input-gear-2", "transmission-driven-gear",
+                  "drawings/train", "cam", "drawings/cam"]
+#: The drawings (construction geometry, for people); every other file cuts.
+DRAWINGS = ("drawings/train", "drawings/cam")
 
 
 @pytest.fixture(scope="module")
@@ -446,7 +460,8 @@ def planting_dxf(tmp_path_factory):
     run = subprocess.run([sys.executable, "-m", "cadgen", "build", str(REFERENCE), "--output-dir",
                           str(folder), "--effects", "dxf"], capture_output=True, text=True)
     assert run.returncode in (0, 1), run.stderr
-    found = {path.stem: path for path in folder.rglob("*.dxf")}
+    found = {(path.stem if path.parent.name != "drawings" else f"drawings/{path.stem}"): path
+             for path in folder.rglob("*.dxf")}
     assert sorted(found) == sorted(PLANTING_FILES)
     return found
 
@@ -464,18 +479,25 @@ def _closes(entity) -> bool:
 @pytest.mark.parametrize("name", PLANTING_FILES, ids=PLANTING_FILES)
 def test_only_cutting_layers_hold_closed_paths_and_only_they_plot(planting_dxf, name):
     doc = ezdxf.readfile(planting_dxf[name])
+    entities = list(doc.modelspace())
+    if name not in DRAWINGS:
+        # a cutting file: only the cutting layers exist, and every entity is a closed path on
+        # them (a CAM program that ignores layers and plot flags takes it as it is)
+        assert {layer.dxf.name for layer in doc.layers} - {"0", "Defpoints"} == set(CUTTING_LAYERS)
+        assert entities and all(_closes(e) and e.dxf.layer in CUTTING_LAYERS for e in entities)
+        assert len(_entities(doc, "OUTLINE", "LWPOLYLINE")) == 1
+        return
     for layer in doc.layers:
         if layer.dxf.name in ("0", "Defpoints"):
             continue
         if layer.dxf.name in CUTTING_LAYERS:
             assert layer.dxf.plot == 1, layer.dxf.name
-        elif name == "train" and layer.dxf.name == LABEL_LAYER:
+        elif name == "drawings/train" and layer.dxf.name == LABEL_LAYER:
             # the train sheet is for people: its labels print (text only, never a path)
             assert layer.dxf.plot == 1
             assert {e.dxftype() for e in doc.modelspace() if e.dxf.layer == LABEL_LAYER} == {"TEXT"}
         else:  # construction: named so, and off paper
             assert layer.dxf.name.startswith("CONSTRUCTION-") and layer.dxf.plot == 0, layer.dxf.name
-    entities = list(doc.modelspace())
     assert {entity.dxf.layer for entity in entities} <= set(export_dxf.LAYERS)
     closed = [entity for entity in entities if _closes(entity)]
     assert closed and all(entity.dxf.layer in CUTTING_LAYERS for entity in closed)
@@ -519,7 +541,7 @@ def _shift(title) -> float:
 
 
 def test_train_sheet_draws_each_gear_plane_apart(planting_dxf):
-    doc = ezdxf.readfile(planting_dxf["train"])
+    doc = ezdxf.readfile(planting_dxf["drawings/train"])
     views = _views(doc)
     assert [names for _, names in views] == [
         {"central", "intermediate"}, {"gear D", "planet gear E"},
@@ -548,7 +570,8 @@ def test_train_sheet_draws_each_gear_plane_apart(planting_dxf):
         assert not any(outline.exterior.intersects(box) for outline in outlines)
 
 
-@pytest.mark.parametrize("name", ["train", "central", "cam"], ids=["train", "gear", "cam"])
+@pytest.mark.parametrize("name", ["drawings/train", "central", "cam", "drawings/cam"],
+                         ids=["train", "gear", "cam", "cam-drawing"])
 def test_labels_print_black_and_construction_is_not_yellow(planting_dxf, name):
     doc = ezdxf.readfile(planting_dxf[name])
     for text in doc.modelspace().query("TEXT"):
@@ -592,7 +615,10 @@ def test_cam_pitch_curve_is_open_construction(tmp_path):
     contour = np.column_stack([(40 + 5 * np.cos(t)) * np.cos(t), (40 + 5 * np.cos(t)) * np.sin(t)])
     pitch = np.column_stack([(48 + 5 * np.cos(t)) * np.cos(t), (48 + 5 * np.cos(t)) * np.sin(t)])
     write_cam_dxf(tmp_path / "cam.dxf", contour, pitch, bore_radius=6.0)
-    doc = ezdxf.readfile(tmp_path / "cam.dxf")
+    cutting = ezdxf.readfile(tmp_path / "cam.dxf")   # the cutting file: outline and bore only
+    assert sorted(e.dxf.layer for e in cutting.modelspace()) == ["BORE", "OUTLINE"]
+    write_cam_dxf(tmp_path / "drawing.dxf", contour, pitch, bore_radius=6.0, drawing=True)
+    doc = ezdxf.readfile(tmp_path / "drawing.dxf")
     (curve,) = _entities(doc, PITCH_LAYER, "LWPOLYLINE")
     points = np.array(curve.get_points(format="xy"))
     assert not curve.closed and np.linalg.norm(points[0] - points[-1]) >= PITCH_CURVE_GAP
@@ -646,7 +672,7 @@ def test_every_label_of_a_pricking_train_sheet_is_clear_of_the_other_gears(tmp_p
     from tests.helpers import REFERENCE
 
     result = build(load_params(REFERENCE.parent / "kernel-b.toml"), tmp_path, effects=["dxf"])
-    doc = ezdxf.readfile(result.output_dir / "gears" / "train.dxf")
+    doc = ezdxf.readfile(result.output_dir / "drawings" / "train.dxf")
     outlines = [shapely.Polygon(e.get_points(format="xy"))
                 for e in _entities(doc, "OUTLINE", "LWPOLYLINE")]
     labels = [t for t in _entities(doc, LABEL_LAYER, "TEXT")

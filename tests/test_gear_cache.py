@@ -30,9 +30,10 @@ def paper():
 
 
 def _files(folder: Path) -> dict:
-    """Every file under gears/ and curves/ of a build's folder: {relative path: bytes}."""
+    """Every file under gears/, drawings/ and curves/ of a build's folder: {relative path:
+    bytes}."""
     return {str(p.relative_to(folder)): p.read_bytes()
-            for sub in ("gears", "curves") for p in sorted((folder / sub).rglob("*"))
+            for sub in ("gears", "drawings", "curves") for p in sorted((folder / sub).rglob("*"))
             if p.is_file()}
 
 
@@ -62,11 +63,12 @@ def test_cached_builds_write_the_bytes_an_uncached_build_writes(paper, uncached,
     for name, data in uncached.items():
         assert cold_files[name] == data, name
         assert warm_files[name] == data, name
-    # every pair's stage, the bytes of every gear file (one per gear and the train sheet) and each
-    # gear's cutting outline
+    # every pair's stage, the bytes of every gear's cutting file and of the train sheet (a
+    # drawing), and each gear's cutting outline
     dxf = [name for name in uncached if name.startswith("gears/")]
+    assert "drawings/train.dxf" in uncached
     assert len(_stage_entries(cache)) == PAIRS
-    assert GearCache(cache).stats()[0] == PAIRS + len(dxf) + (len(dxf) - 1)
+    assert GearCache(cache).stats()[0] == PAIRS + (len(dxf) + 1) + len(dxf)
 
 
 def _stage_entries(cache: Path) -> list:
@@ -152,7 +154,7 @@ def test_a_warm_build_thins_no_gear_outline_again(paper, tmp_path, monkeypatch):
                   for f in sorted(cold.output_dir.rglob("*")) if f.is_file()}
     warm_files = {f.relative_to(warm.output_dir): f.read_bytes()
                   for f in sorted(warm.output_dir.rglob("*")) if f.is_file()}
-    assert {str(name) for name in cold_files} >= {"gears/train.dxf", "solids/sun.stl"}
+    assert {str(name) for name in cold_files} >= {"drawings/train.dxf", "solids/sun.stl"}
     for name, data in cold_files.items():
         if name.name != "report.json":       # stage times, cache hits
             assert warm_files[name] == data, name
@@ -163,7 +165,7 @@ def test_a_warm_build_thins_no_gear_outline_again(paper, tmp_path, monkeypatch):
     store = GearCache(cache)
     outlines = [entry for entry in sorted(cache.glob("??/*.gear"))
                 if isinstance(store.get(entry.stem), CuttingOutline)]
-    assert len(outlines) == sum(name.parent.name == "gears" for name in cold_files) - 1
+    assert len(outlines) == sum(name.parent.name == "gears" for name in cold_files)
     for victim in outlines:
         victim.write_bytes(victim.read_bytes()[:-7])
     again = cadgen.build(paper, tmp_path / "again", effects=effects, cache=cache)
@@ -179,7 +181,7 @@ def test_a_damaged_file_entry_is_made_again(paper, uncached, tmp_path):
     store = GearCache(cache)
     files = [entry for entry in sorted(cache.glob("??/*.gear"))
              if isinstance(store.get(entry.stem), bytes)]
-    assert len(files) == sum(name.startswith("gears/") for name in uncached)
+    assert len(files) == sum(name.startswith("gears/") for name in uncached) + 1   # the sheet
     for victim in files[:3]:
         data = victim.read_bytes()
         victim.write_bytes(data[:-1] + bytes([data[-1] ^ 0x01]))   # a payload byte flipped

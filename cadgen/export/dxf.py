@@ -1,9 +1,10 @@
 """DXF export of generated gears (one cutting file per gear, an assembled train sheet) and cams
 (the cam's file: :mod:`cadgen.export.cam_dxf`, on this module's layers and document).
 
-Layers, in millimetres. Only the two *cutting* layers hold cutting paths, and they are plotted;
-everything else is construction geometry on ``CONSTRUCTION-...`` layers whose plot flag is off
-(a CAM program filtering by layer takes ``OUTLINE`` and ``BORE`` only):
+Layers, in millimetres. A *cutting file* (one gear, the cam) has the two cutting layers only,
+so a CAM program takes it as it is, whatever it does with layers and plot flags. A *drawing*
+(the train sheet, the cam's drawing) adds the construction geometry on ``CONSTRUCTION-...``
+layers whose plot flag is off:
 
 ``OUTLINE`` (colour 7)
     The tooth outline (cam: the working profile), one closed ``LWPOLYLINE``.
@@ -262,7 +263,10 @@ def _fixed_metadata():
             ezdxf.options.write_fixed_meta_data_for_testing = previous
 
 
-def _new_document(printed=()):
+def _new_document(printed=(), layers=None):
+    """A millimetre document with the project's ``layers`` (default: every layer; a cutting
+    file: :data:`CUTTING_LAYERS` only, so a CAM program that ignores plot flags finds nothing
+    but cutting paths)."""
     import ezdxf
 
     with _fixed_metadata():
@@ -273,7 +277,7 @@ def _new_document(printed=()):
     doc.header["$LUNITS"] = 2  # decimal
     if _CENTRE_LINETYPE not in doc.linetypes:
         doc.linetypes.add(_CENTRE_LINETYPE, pattern=_CENTRE_LINETYPE_PATTERN, description="Centre ____ _ ____ _")
-    for name, colour in LAYERS.items():
+    for name, colour in (LAYERS if layers is None else layers).items():
         layer = doc.layers.add(name, color=colour)
         layer.dxf.plot = 1 if name in CUTTING_LAYERS or name in printed else 0
         layer.description = ("cutting path" if name in CUTTING_LAYERS else
@@ -387,16 +391,19 @@ def _fast_vertices() -> bool:
 
 
 def _add_gear(msp, outline: np.ndarray, pitch: np.ndarray, centre: np.ndarray, bore_radius: float,
-              module: float, hole=None) -> None:
+              module: float, hole=None, *, construction: bool = True) -> None:
     """Add one placed gear's entities (already in sheet coordinates) to the modelspace; its
-    ``hole`` (placed likewise) is drawn in place of the bore circle."""
+    ``hole`` (placed likewise) is drawn in place of the bore circle. ``construction`` False (a
+    cutting file): the outline and the bore only, no pitch curve, no centre mark."""
     _add_polyline(msp, outline, close=True, layer="OUTLINE")
-    _add_polyline(msp, open_ring(pitch, PITCH_CURVE_GAP), close=False, layer=PITCH_LAYER)
+    if construction:
+        _add_polyline(msp, open_ring(pitch, PITCH_CURVE_GAP), close=False, layer=PITCH_LAYER)
     if hole is not None:
         _add_polyline(msp, closed_points(hole), close=True, layer="BORE")
     elif bore_radius > 0:
         msp.add_circle(centre.tolist(), bore_radius, dxfattribs={"layer": "BORE"})
-    _add_centre_mark(msp, centre, CENTRE_MARK_HALF_LENGTH_MODULES * module)
+    if construction:
+        _add_centre_mark(msp, centre, CENTRE_MARK_HALF_LENGTH_MODULES * module)
 
 
 def _text_box(anchor, text: str, height: float) -> np.ndarray:
@@ -553,10 +560,10 @@ def write_gear_dxf(path: str | os.PathLike, profile, *, chord_tolerance: float =
 
     Notes
     -----
-    Cutting layers (plotted): ``OUTLINE`` (one closed LWPOLYLINE, counter-clockwise),
-    ``BORE`` (the hole as a closed LWPOLYLINE, else a CIRCLE, if any). Construction layers (not plotted): ``CONSTRUCTION-PITCH``
-    (open LWPOLYLINE, its closing stretch of at least :data:`PITCH_CURVE_GAP` left out),
-    ``CONSTRUCTION-CENTRE`` (two LINEs crossing at the centre, two modules long).
+    A cutting file: its only layers are ``OUTLINE`` (one closed LWPOLYLINE,
+    counter-clockwise) and ``BORE`` (the hole as a closed LWPOLYLINE, else a CIRCLE, if
+    any), so a CAM program takes it as it is. The gear's pitch curve and centre mark are on
+    the train sheet (:func:`cadgen.export.train_sheet.write_train_sheet`), a drawing.
     """
     tolerance = _check_tolerance(chord_tolerance)
     _raise_gear_problems(profile)
@@ -573,9 +580,10 @@ def gear_dxf_bytes(profile, outline: np.ndarray, pitch: np.ndarray, *, path="gea
     already checked (:func:`_raise_gear_problems`) and its outline and pitch curve already
     thinned (:func:`cadgen.machine.hubs.cutting_outline`). ``path`` only names the file in an
     audit failure."""
-    doc = _new_document()
+    doc = _new_document(layers=CUTTING_LAYERS)
     _add_gear(doc.modelspace(), outline, pitch, np.asarray(profile.centre, dtype=float),
-              float(profile.bore_radius), float(profile.module), getattr(profile, "hole", None))
+              float(profile.bore_radius), float(profile.module), getattr(profile, "hole", None),
+              construction=False)
     return _audited_bytes(doc, Path(path))
 
 

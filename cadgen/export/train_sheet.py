@@ -24,7 +24,11 @@ from cadgen.export.dxf import (CENTRE_MARK_HALF_LENGTH_MODULES, LABEL_GAP_MODULE
                                _text_box, _thin_gear, gear_dxf_bytes, writer_fingerprint)
 from cadgen.geometry.contour import closed_points, ring_measures
 
-__all__ = ["write_train_sheet", "write_train_files", "train_files", "CachedFiles"]
+__all__ = ["write_train_sheet", "write_train_files", "train_files", "CachedFiles", "SHEET_NAME"]
+
+#: The train sheet's file name (a build writes it under ``drawings/``, apart from the gears'
+#: cutting files).
+SHEET_NAME = "train.dxf"
 
 
 def write_train_sheet(path: str | os.PathLike, placements, *, chord_tolerance: float = 0.005,
@@ -290,7 +294,7 @@ def train_files(train, chord_tolerance: float, cache=None, *, folder=Path(".")) 
         made.append((path.name, files.get(("gear dxf", profile), lambda profile=profile, path=path:
                                           gear_dxf_bytes(profile, *_cut(profile, tolerance)[::2],
                                                          path=path))))
-    sheet = folder / "train.dxf"
+    sheet = folder / SHEET_NAME
 
     def make_sheet():
         checked = _checked_sheet(placements, LABEL_HEIGHT, planes, profiles=False)

@@ -58,7 +58,9 @@ def prepare(run) -> int:
     if "dxf" in run.effects and run.status("teeth") == "ok" and run.values["teeth"].stages:
         made += _made_ahead(run, "_gear_files", lambda: _gear_files(run, Path("gears")))
     if "dxf" in run.effects and run.status("cam") == "ok" and run.values["cam"].cuttable:
-        made += _made_ahead(run, "_cam_file", lambda: _cam_file(run, Path("cam.dxf")))
+        made += _made_ahead(run, "_cam_file", lambda: (_cam_file(run, Path("cam.dxf")),
+                                                       _cam_file(run, Path(DRAWINGS) / "cam.dxf",
+                                                                 drawing=True)))
     if "report" in run.effects:
         animation_of(run)
         made += 1
@@ -95,15 +97,21 @@ def _write_bom(run, staging):
     return ["bom.csv"]
 
 
+#: Where the drawings go (the train sheet, the cam's drawing): apart from the cutting files, so
+#: a CAM program loading a folder of cutting files finds no construction geometry.
+DRAWINGS = "drawings"
+
+
 def _write_gears(run, staging):
     from cadgen.export.atomic import write_bytes_atomic
+    from cadgen.export.train_sheet import SHEET_NAME
 
-    folder = staging / "gears"
-    folder.mkdir()
     written = []
-    for name, data in _gear_files(run, folder):
-        write_bytes_atomic(folder / name, data)
-        written.append(f"gears/{name}")
+    for name, data in _gear_files(run, staging / "gears"):
+        folder = DRAWINGS if name == SHEET_NAME else "gears"   # the sheet is a drawing
+        (staging / folder).mkdir(exist_ok=True)
+        write_bytes_atomic(staging / folder / name, data)
+        written.append(f"{folder}/{name}")
     return written
 
 
@@ -123,16 +131,21 @@ def _write_cam(run, staging):
     from cadgen.export.atomic import write_bytes_atomic
 
     write_bytes_atomic(staging / "cam.dxf", _cam_file(run, staging / "cam.dxf"))
-    return ["cam.dxf"]
+    (staging / DRAWINGS).mkdir(exist_ok=True)
+    drawing = staging / DRAWINGS / "cam.dxf"
+    write_bytes_atomic(drawing, _cam_file(run, drawing, drawing=True))
+    return ["cam.dxf", f"{DRAWINGS}/cam.dxf"]
 
 
-def _cam_file(run, path: Path) -> bytes:
-    """The cam's DXF bytes (``path`` names it in error messages), made once per run:
-    :func:`prepare` may have made them. Kept in the gear cache beside the gear files when the
-    build cut its teeth with one (keyed on the contour, the pitch curve, the bore, the chord
-    tolerance and the writers' sources): a warm build never loads ezdxf."""
+def _cam_file(run, path: Path, drawing: bool = False) -> bytes:
+    """The cam's DXF bytes (``path`` names it in error messages): the cutting file, or its
+    ``drawing`` (with the roller's pitch curve); made once per run: :func:`prepare` may have
+    made them. Kept in the gear cache beside the gear files when the build cut its teeth with
+    one (keyed on the contour, the pitch curve, the bore, the holes, the chord tolerance and
+    the writers' sources): a warm build never loads ezdxf."""
     made = run.__dict__.setdefault("_cam_file", {})
-    if "bytes" not in made:
+    kind = "drawing" if drawing else "bytes"
+    if kind not in made:
         from cadgen.export.cam_dxf import cam_dxf_bytes
         from cadgen.export.train_sheet import CachedFiles
 
@@ -155,12 +168,12 @@ def _cam_file(run, path: Path) -> bytes:
         tolerance = params.gears.chord_tolerance
         # the teeth's cache (a scene without teeth touches none)
         cache = getattr(run.values.get("teeth"), "cache", None)
-        made["bytes"] = CachedFiles(cache, tolerance).get(
-            ("cam dxf", np.asarray(contour, dtype=float), np.asarray(pitch, dtype=float),
+        made[kind] = CachedFiles(cache, tolerance).get(
+            ("cam dxf", kind, np.asarray(contour, dtype=float), np.asarray(pitch, dtype=float),
              float(bore), tuple((tuple(c), r) for c, r in holes)),
             lambda: cam_dxf_bytes(contour, pitch, bore_radius=bore, chord_tolerance=tolerance,
-                                  path=path, holes=holes))
-    return made["bytes"]
+                                  path=path, holes=holes, drawing=drawing))
+    return made[kind]
 
 
 #: Samples per turn of each tabulated pitch curve.

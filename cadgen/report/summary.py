@@ -228,6 +228,13 @@ def format_solids(solids: dict) -> str:
                  else "; the gears' faces do not fit between its floor and roof")
         lines.append(f"     {row['housing']} {state} (smallest margin {_number(margin, '.2f')} mm, "
                      f"{row.get('nearest_gear') or MISSING}{axial})")
+    overlaps = solids.get("overlaps")
+    if overlaps:
+        if overlaps["failures"]:
+            lines += [f"     OVERLAP: {failure}" for failure in overlaps["failures"]]
+        else:
+            lines.append(f"     no parts overlap ({overlaps['pairs_examined']} touching pairs "
+                         "intersected; only their fits' chord-error shells)")
     volume = solids.get("build_volume_mm")
     for part in solids.get("too_big_for_build_volume") or []:
         size = " x ".join(_number(v, ".1f") for v in part["print_extents_mm"])
