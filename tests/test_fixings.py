@@ -146,3 +146,71 @@ def test_a_joined_shell_within_the_chord_error_passes_and_a_thick_one_does_not()
                                      (_Part("hub", m3d.Manifold.cylinder(10.0, 15.0, 15.0, 64),
                                             "gear"), eye)], model), segments=64)
     assert not solid["passed"] and solid["overlaps"][0]["thickness_mm"] > 1.0
+
+
+# ------------------------------------------------------------------ dowels and alignment
+def test_dowels_and_the_seats_tilt_by_hand():
+    from cadgen.machine.fits import deviation
+    from cadgen.machine.fixings import dowel_pins, seat_misalignment
+
+    # ISO 286-2: m6 over 18 up to 30 mm is +8 / +21 um; over 3 up to 6, +4 / +12
+    assert deviation("m6", 20) == pytest.approx((0.008, 0.021))
+    assert deviation("m6", 4) == pytest.approx((0.004, 0.012))
+    pins = dowel_pins("M3", 9.0)   # a 9 mm flange pair: the 8 mm pin stays within it
+    assert (pins["diameter"], pins["length"]) == (3.0, 8.0)
+    assert pins["designation"] == "ISO 8734 3 x 8 - A - St"
+    # H7 on 3 mm: 0 / +10 um; m6: +2 / +8 um: the largest clearance 10 - 2 = 8 um
+    assert pins["clearance_max_mm"] == pytest.approx(0.008)
+    assert dowel_pins("M4", 12.0)["designation"] == "ISO 8734 4 x 12 - A - St"
+    # seats 68 mm apart, bores placed to 0.01 mm: atan((0.008 + 0.02) / 68) in arc minutes
+    assert seat_misalignment(68.0, 0.008, 0.01) == pytest.approx(
+        math.degrees(math.atan(0.028 / 68.0)) * 60.0)
+    assert seat_misalignment(68.0, 0.008, 0.01) == pytest.approx(1.4156, abs=1e-4)
+
+
+def test_the_dowel_holes_go_through_both_halves_in_the_flange():
+    import shapely
+
+    from cadgen.solids.machine_parts import dowel_positions, with_dowels
+    from cadgen.solids.split_housing import split_housing
+
+    housing = split_housing([(0.0, 0.0, 30.0), (70.0, 0.0, 20.0)], clearance=2.0, wall=4.0,
+                            floor_wall=6.0, roof_wall=6.0, cavity_height=20.0,
+                            z_cavity_bottom=0.0, parting_z=10.0, bolt_size="M4",
+                            bolt_hole_diameter=4.5, segments=64)
+    dowelled = with_dowels(housing)
+    assert len(dowelled.dowels) == 2
+    # the closed form counts the holes: it equals the solids' volume
+    solid = (dowelled.base + dowelled.cover).volume()
+    assert dowelled.volume == pytest.approx(solid, rel=1e-9)
+    assert housing.volume - dowelled.volume == pytest.approx(
+        2 * math.pi * 2.0**2 * (dowelled.flange_z[1] - dowelled.flange_z[0]), rel=0.01)
+    outer = shapely.Polygon(housing.outer_outline)
+    flange = shapely.Polygon(housing.flange_outline)
+    positions = dowel_positions(housing)
+    for x, y in positions:   # in the flange strip, clear of the wall and the edge
+        point = shapely.Point(x, y)
+        assert flange.contains(point.buffer(2.0)) and not outer.intersects(point.buffer(2.0))
+    # far apart: the largest distance between any two bolt gaps' middles
+    assert math.dist(*positions) > 0.8 * np.ptp(housing.flange_outline[:, 0])
+    for half, z in ((dowelled.base, 9.0), (dowelled.cover, 11.0)):
+        section = half.slice(z)   # a cross-section at that height
+        holes = [shapely.Polygon(loop) for loop in section.to_polygons()]
+        for x, y in positions:
+            assert any(abs(p.area - math.pi * 4.0) < 0.05 * math.pi * 4.0
+                       and p.contains(shapely.Point(x, y)) for p in holes), (z, x, y)
+
+
+def test_a_printed_housings_seats_warn_of_their_tilt():
+    from cadgen.report.content import check_warnings
+
+    def report(tolerance):
+        angle = math.degrees(math.atan((0.008 + 2 * tolerance) / 68.0)) * 60.0
+        return {"solids": {"alignment": [{
+            "housing": "gearbox1", "shaft": "A", "side": 1, "span_mm": 68.0,
+            "dowel_clearance_mm": 0.008, "position_tolerance_mm": tolerance,
+            "misalignment_arcmin": angle, "allowance_arcmin": 10.0, "passed": angle <= 10.0}]}}
+
+    assert check_warnings(report(0.01)) == []
+    [warning] = check_warnings(report(0.1))   # an FDM print places its bores to 0.1 mm
+    assert warning["code"] == "seats_misaligned" and "10.5'" in warning["message"]

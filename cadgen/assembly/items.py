@@ -12,7 +12,7 @@ from __future__ import annotations
 from cadgen.assembly.graph import Item
 
 __all__ = ["bearing_item", "key_item", "bolt_set", "bolted_flange_items", "screw_items",
-           "sprocket_items"]
+           "sprocket_items", "dowel_items"]
 
 
 def bearing_item(bearing, count: int) -> Item:
@@ -79,3 +79,13 @@ def sprocket_items(held: dict) -> tuple[Item, ...]:
              f"on a {2 * sprocket['bolt_circle_radius']:.1f} mm circle")
     return ((Item("sprocket", wheel, f"ISO 606 {chain} z{sprocket['teeth']}", 1),)
             + screw_items(sprocket["bolt"], sprocket["width"], int(sprocket["bolts"])))
+
+
+def dowel_items(housing) -> tuple[Item, ...]:
+    """A split housing's dowel pins (ISO 8734, :func:`cadgen.machine.fixings.dowel_pins`)."""
+    from cadgen.machine.fixings import dowel_pins
+
+    low, high = housing.flange_z
+    pins = dowel_pins(housing.bolt_size, high - low)
+    return (Item("dowel pin", f"dowel pin {pins['designation']} ({pins['fit']})",
+                 pins["designation"], len(housing.dowels)),)

@@ -30,8 +30,8 @@ import math
 import re
 
 from cadgen.assembly.graph import AssemblyModel, Item, Joint, Placement
-from cadgen.assembly.items import (bearing_item, bolted_flange_items, key_item, screw_items,
-                                   sprocket_items)
+from cadgen.assembly.items import (bearing_item, bolted_flange_items, dowel_items, key_item,
+                                   screw_items, sprocket_items)
 
 __all__ = ["planting_model", "pricking_model", "NOT_MADE", "model_report", "ENVIRONMENT"]
 
@@ -95,6 +95,8 @@ class _Builder:
         if record is not None and getattr(record, "bolt_positions", None) is not None:
             bolts = bolted_flange_items(record.bolt_size, 2 * float(record.flange_thickness),
                                         len(record.bolt_positions))
+        if record is not None and getattr(record, "dowels", ()):
+            bolts += dowel_items(record)
         for k, (cover, base) in enumerate(zip(halves["cover"], halves["base"])):
             self.joint("fixed", cover, base, "flange bolts", bolts if k == 0 else ())
         splices = list(getattr(record, "joints", ()) or ())

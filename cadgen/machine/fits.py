@@ -42,6 +42,8 @@ _G_UPPER = (-2, -4, -5, -6, -7, -9, -10, -12)
 #: Fundamental deviation of k shafts, the lower deviation ei for grades IT4 to IT7
 #: (ISO 286-1 table 3; other grades and sizes up to 3 mm have ei = 0), um.
 _K_LOWER = (0, 1, 1, 1, 2, 2, 2, 3)
+#: ISO 286-2 fundamental deviation ei of "m" shafts (um), by the same size steps.
+_M_LOWER = (2, 4, 6, 7, 8, 9, 11, 13)
 
 
 def _step(nominal: float) -> int:
@@ -77,10 +79,10 @@ def deviation(designation: str, nominal: float) -> tuple:
     >>> deviation("k6", 20)
     (0.002, 0.015)
     """
-    match = re.fullmatch(r"(H|h|k|g|js|JS)(\d+)", designation.strip())
+    match = re.fullmatch(r"(H|h|k|m|g|js|JS)(\d+)", designation.strip())
     if not match:
-        raise FitError(f"tolerance class {designation!r} is not one of H, h, k, g, js, JS with a "
-                       "grade (e.g. 'H7', 'k6')")
+        raise FitError(f"tolerance class {designation!r} is not one of H, h, k, m, g, js, JS "
+                       "with a grade (e.g. 'H7', 'k6')")
     letter, grade = match.group(1), int(match.group(2))
     step = _step(nominal)
     if grade not in _IT:
@@ -96,6 +98,9 @@ def deviation(designation: str, nominal: float) -> tuple:
     elif letter == "g":
         upper = _G_UPPER[step]
         lower = upper - it
+    elif letter == "m":
+        lower = _M_LOWER[step]
+        upper = lower + it
     else:   # k
         lower = _K_LOWER[step] if 4 <= grade <= 7 else 0
         upper = lower + it
@@ -155,6 +160,7 @@ class ProcessFits:
     bolt_hole_series: str     # ISO 273
     bolt_hole_extra: float    # added to the ISO 273 hole (printed holes shrink)
     materials: dict = field(default_factory=dict)
+    position_tolerance: float = 0.01   # a bore's or dowel hole's position (mm, radius): CNC
 
     def seat_allowance(self, outside: float) -> float:
         """Bearing seat bore minus the bearing's outside diameter ``outside`` (mm)."""
@@ -182,6 +188,7 @@ class ProcessFits:
                 "key_slot_allowance_mm": self.key_slot_allowance, "backlash_mm": self.backlash,
                 "bolt_hole_series": self.bolt_hole_series,
                 "bolt_hole_extra_mm": self.bolt_hole_extra,
+                "position_tolerance_mm": self.position_tolerance,
                 "materials": {k: m._asdict() for k, m in self.materials.items()}}
 
 
@@ -197,6 +204,7 @@ _PROCESSES = {
         backlash=0.20,                # FDM tooth flanks deviate by about a layer width's part
         bolt_hole_series="medium",
         bolt_hole_extra=0.2,          # printed holes come out about 0.2 mm small
+        position_tolerance=0.1,       # an FDM printer places a hole to about 0.1 mm
         materials=_materials(gear=(*_PETG, "printed"), cam=(*_PETG, "printed"),
                              planter=(*_PETG, "printed"), housing=(*_PETG, "printed"),
                              blade=(*_PETG, "printed"), rocker=(*_PETG, "printed"),

@@ -25,7 +25,8 @@ from cadgen.machine.catalogue import CatalogueError, key_lengths, screw_length, 
 from cadgen.machine.shafts import KEYLESS_BELOW, FLAT_DEPTH_RATIO, key_for_shaft, key_pressure
 
 __all__ = ["keyed_hub", "screwed_plate", "needle_clamp", "arm_fixings", "fixings_report",
-           "TAP_DRILL", "COUNTERBORE",
+           "dowel_pins", "seat_misalignment", "BEARING_MISALIGNMENT_ARCMIN", "TAP_DRILL",
+           "COUNTERBORE",
            "HUB_CHAMFER", "HUB_OUTSIDE_RATIO", "HUB_LENGTH_MAX_RATIO"]
 
 #: Tap drill diameters for coarse threads, ISO 2306 (mm).
@@ -186,6 +187,39 @@ def needle_clamp(needle_diameter: float, holder_length: float, fit_clearance: fl
              "set_screw": f"ISO 4027 {thread} x {length:g} - 45H", "thread": thread,
              "tap_drill": TAP_DRILL[thread], "screw_length": float(length)}
     return clamp, problems
+
+
+# ------------------------------------------------------------------ dowels and alignment
+#: ISO 8734 dowel pins (hardened, m6): diameters and standard lengths (mm).
+DOWEL_DIAMETERS = (2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
+DOWEL_LENGTHS = (4, 5, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30, 32, 35, 40, 45, 50)
+#: What a deep-groove ball bearing accepts between its rings (arc minutes): SKF gives 2' to
+#: 10' for deep-groove ball bearings; the upper end, as the bearing runs lightly loaded.
+BEARING_MISALIGNMENT_ARCMIN = 10.0
+
+
+def dowel_pins(bolt: str, flange_height: float) -> dict:
+    """Two ISO 8734 dowels locating a cover on its base: as thick as the flange's bolts, the
+    longest standard length within both flange halves (a pin flush with the outer faces), in
+    H7 holes reamed through both halves; their fit's largest clearance (H7 hole on an m6 pin)."""
+    from cadgen.machine.fits import deviation
+
+    size = float(bolt.removeprefix("M"))
+    diameter = max(d for d in DOWEL_DIAMETERS if d <= size + 1e-9)
+    lengths = [n for n in DOWEL_LENGTHS if n <= flange_height + 1e-9]
+    length = float(lengths[-1]) if lengths else float(DOWEL_LENGTHS[0])
+    clearance = deviation("H7", diameter)[1] - deviation("m6", diameter)[0]
+    return {"diameter": diameter, "length": length, "count": 2,
+            "designation": f"ISO 8734 {diameter:g} x {length:g} - A - St",
+            "fit": "H7/m6", "clearance_max_mm": clearance}
+
+
+def seat_misalignment(span: float, dowel_clearance: float, position_tolerance: float) -> float:
+    """The largest tilt (arc minutes) between two coaxial bearing seats ``span`` apart, one bored
+    in the base and one in the cover: the cover can shift on its dowels by their fit's
+    clearance, and each seat may sit off its place by the process's position tolerance."""
+    offset = dowel_clearance + 2.0 * position_tolerance
+    return math.degrees(math.atan2(offset, span)) * 60.0
 
 
 # ------------------------------------------------------------------ the machines' fixings

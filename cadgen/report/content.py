@@ -320,6 +320,15 @@ def check_warnings(report: dict) -> list:
             if problem["code"] not in FAILING_RIM_PROBLEMS:
                 out.append({"check": "gear hubs", "path": problem.get("path", ""),
                             "code": problem["code"], "message": problem["message"]})
+    for row in report.get("solids", {}).get("alignment", []):
+        if not row["passed"]:
+            out.append({"check": "seat alignment", "path": "manufacturing.process",
+                        "code": "seats_misaligned",
+                        "message": f"shaft {row['shaft']}'s seats in {row['housing']}'s base and "
+                                   f"cover can tilt {row['misalignment_arcmin']:.1f}' against "
+                                   f"each other ({row['span_mm']:.1f} mm apart), more than the "
+                                   f"{row['allowance_arcmin']:g}' a deep-groove ball bearing "
+                                   "accepts: bore both seats in one set-up, or machine the housing"})
     for finding in report.get("findings", []):
         gear = finding.get("path", "").removeprefix("gears.").replace("_", " ")
         if finding["code"] in PREDICTED_FINDINGS and gear not in cut:

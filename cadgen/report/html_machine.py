@@ -127,6 +127,7 @@ def machine_section_html(report: dict) -> str:
             rows, numeric=(1, 2, 3)))
     body.append(_transmission_html(report))
     body.append(_fixings_html(machine.get("fixings") or {}))
+    body.append(_alignment_html((report.get("solids") or {}).get("alignment") or []))
     body.append(_joint_graph_html(report.get("assembly")))
     problems = machine.get("problems", [])
     if problems:
@@ -219,6 +220,24 @@ def _fixings_html(fixings: dict) -> str:
         return ""
     return ("<h3>How the arm's parts are fixed</h3>"
             + _table(["part", "fixing", "check", ""], rows))
+
+
+def _alignment_html(rows: list) -> str:
+    """Each shaft's two seats, bored in a dowelled base and cover: the tilt they can have."""
+    if not rows:
+        return ""
+    table = [[_e(f"{r['shaft']}" + (f" (side {r['side']})" if r["side"] != 1 else "")),
+              _e(r["housing"]), _e(_number(r["span_mm"], 1)),
+              _e(_number(r["dowel_clearance_mm"], 3)), _e(_number(r["position_tolerance_mm"], 3)),
+              _e(_number(r["misalignment_arcmin"], 2)), _e(_number(r["allowance_arcmin"], 0)),
+              _badge("pass" if r["passed"] else "warn")] for r in rows]
+    return ("<h3>Bearing seats' alignment (two ISO 8734 dowels per cover)</h3>"
+            "<p class=\"note\">The tilt two coaxial seats can have, one in the base and one in "
+            "the cover: the dowels' largest H7/m6 clearance plus each bore's position tolerance, "
+            "over the seats' span, against what a deep-groove ball bearing accepts.</p>"
+            + _table(["shaft", "housing", "span (mm)", "dowel clearance (mm)",
+                      "bore position (mm)", "tilt (')", "accepted (')", ""], table,
+                     numeric=(2, 3, 4, 5, 6)))
 
 
 def _joint_graph_html(assembly) -> str:

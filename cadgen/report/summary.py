@@ -235,6 +235,13 @@ def format_solids(solids: dict) -> str:
         else:
             lines.append(f"     no parts overlap ({overlaps['pairs_examined']} touching pairs "
                          "intersected; only their fits' chord-error shells)")
+    alignment = solids.get("alignment") or []
+    if alignment:
+        worst = max(alignment, key=lambda row: row["misalignment_arcmin"])
+        lines.append(f"     bearing seats' alignment: worst {worst['misalignment_arcmin']:.1f}' "
+                     f"(shaft {worst['shaft']} in {worst['housing']}; dowelled cover, "
+                     f"{_number(worst['position_tolerance_mm'], 'g')} mm bore positions), "
+                     f"bearings accept {_number(worst['allowance_arcmin'], 'g')}'")
     volume = solids.get("build_volume_mm")
     for part in solids.get("too_big_for_build_volume") or []:
         size = " x ".join(_number(v, ".1f") for v in part["print_extents_mm"])

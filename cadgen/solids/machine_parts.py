@@ -21,7 +21,8 @@ import math
 
 from cadgen.solids.parts import Part, planar_transform
 
-__all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "housing_parts",
+__all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "with_dowels", "dowel_positions",
+           "housing_parts",
            "printed_housing_parts", "shaft_part", "shaft_ends"]
 
 #: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
@@ -77,13 +78,59 @@ def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: floa
     from cadgen.solids.split_housing import split_housing
 
     size, hole = housing_bolt(params, shell.wall)
-    return split_housing(circles, clearance=shell.clearance, wall=shell.wall,
-                         floor_wall=stack.floor_wall, roof_wall=stack.roof_wall,
-                         cavity_height=stack.cavity_height, z_cavity_bottom=z_cavity_bottom,
-                         parting_z=z_cavity_bottom + stack.parting_z,
-                         seats=seats, bolt_size=size,
-                         bolt_hole_diameter=hole, segments=segments, path=path,
-                         passages=passages, tapped=tapped)
+    housing = split_housing(circles, clearance=shell.clearance, wall=shell.wall,
+                            floor_wall=stack.floor_wall, roof_wall=stack.roof_wall,
+                            cavity_height=stack.cavity_height, z_cavity_bottom=z_cavity_bottom,
+                            parting_z=z_cavity_bottom + stack.parting_z,
+                            seats=seats, bolt_size=size,
+                            bolt_hole_diameter=hole, segments=segments, path=path,
+                            passages=passages, tapped=tapped)
+    return with_dowels(housing)
+
+
+def dowel_positions(housing) -> list:
+    """Where a split housing's two dowels go: in the flange between two bolts, the two gaps
+    farthest apart (the cover is then located across its whole length), each on the flange's
+    middle line (half way between the housing's outer outline and the flange's)."""
+    import numpy as np
+    import shapely
+
+    bolts = np.asarray(housing.bolt_positions, dtype=float)
+    outer = shapely.LinearRing(housing.outer_outline)
+    flange = shapely.LinearRing(housing.flange_outline)
+    gaps = []
+    for a, b in zip(bolts, np.roll(bolts, -1, axis=0)):
+        chord = shapely.Point(0.5 * (a + b))
+        near = [ring.interpolate(ring.project(chord)) for ring in (outer, flange)]
+        gaps.append(0.5 * (np.array(near[0].coords[0]) + np.array(near[1].coords[0])))
+    pairs = [(i, j) for i in range(len(gaps)) for j in range(i + 1, len(gaps))]
+    i, j = max(pairs, key=lambda ij: float(np.linalg.norm(gaps[ij[0]] - gaps[ij[1]])))
+    return [tuple(map(float, gaps[i])), tuple(map(float, gaps[j]))]
+
+
+def with_dowels(housing):
+    """``housing`` with its two ISO 8734 dowels' holes reamed through both flange halves
+    (:func:`cadgen.machine.fixings.dowel_pins` sizes them)."""
+    from dataclasses import replace
+
+    from cadgen.machine.fixings import dowel_pins
+    from cadgen.solids.extrude import manifold3d_engine
+    from cadgen.solids.split_housing import TAPPED_SEGMENTS
+
+    if len(housing.bolt_positions) < 2:
+        return housing
+    m3d = manifold3d_engine()
+    low, high = housing.flange_z
+    pins = dowel_pins(housing.bolt_size, high - low)
+    radius = pins["diameter"] / 2
+    holes = None
+    for x, y in dowel_positions(housing):
+        hole = m3d.Manifold.cylinder(high - low + 2.0, radius, radius, TAPPED_SEGMENTS
+                                     ).translate((x, y, low - 1.0))
+        holes = hole if holes is None else holes + hole
+    dowels = tuple((x, y, pins["diameter"]) for x, y in dowel_positions(housing))
+    return replace(housing, base=housing.base - holes, cover=housing.cover - holes,
+                   dowels=dowels)
 
 
 def housing_parts(name: str, housing, body: str) -> list:

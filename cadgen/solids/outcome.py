@@ -287,6 +287,34 @@ def _overlaps(outcome: SolidsOutcome, fits) -> dict:
                          interference=interference)
 
 
+def _alignment(outcome: SolidsOutcome, fits) -> list:
+    """Each shaft whose two bearing seats are bored in one housing's base and cover: how far the
+    seats can tilt against each other (the cover shifting on its dowels, each bore off its place
+    by the process's position tolerance) against what a deep-groove ball bearing accepts."""
+    from cadgen.machine.fixings import BEARING_MISALIGNMENT_ARCMIN, dowel_pins, seat_misalignment
+
+    rows = []
+    for name, housing in outcome.housings.items():
+        if not getattr(housing, "dowels", ()):
+            continue
+        low, high = housing.flange_z
+        clearance = dowel_pins(housing.bolt_size, high - low)["clearance_max_mm"]
+        floors = {(s.shaft, s.side, tuple(s.xy)): s for s in housing.seats if s.wall == "floor"}
+        for seat in housing.seats:
+            floor = floors.get((seat.shaft, seat.side, tuple(seat.xy)))
+            if seat.wall != "roof" or floor is None:
+                continue
+            span = housing.cavity_height + (floor.depth + seat.depth) / 2
+            angle = seat_misalignment(span, clearance, fits.position_tolerance)
+            rows.append({"housing": name, "shaft": seat.shaft, "side": seat.side,
+                         "span_mm": span, "dowel_clearance_mm": clearance,
+                         "position_tolerance_mm": fits.position_tolerance,
+                         "misalignment_arcmin": angle,
+                         "allowance_arcmin": BEARING_MISALIGNMENT_ARCMIN,
+                         "passed": angle <= BEARING_MISALIGNMENT_ARCMIN})
+    return rows
+
+
 def solids_report(outcome: SolidsOutcome) -> dict:
     """Mass properties per part, the enclosure checks and the assembly's pose (report.json);
     computed once per outcome (a copy each call)."""
@@ -335,6 +363,7 @@ def _solids_report(outcome: SolidsOutcome) -> dict:
                          "units": "m" if outcome.file_type == "glb" else "mm"},
             "enclosure": outcome.enclosure,
             "overlaps": _overlaps(outcome, materials),
+            "alignment": _alignment(outcome, materials),
             "build_volume_mm": [float(v) for v in outcome.build_volume],
             "too_big_for_build_volume": too_big,
             "frames": "each STL in its printing pose: largest flat face down on z = 0, centred "

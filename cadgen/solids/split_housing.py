@@ -139,6 +139,7 @@ class SplitHousing:
     # ``(x, y, diameter, depth, wall)`` tapped from the wall's outer face (a flange's screws)
     passages: tuple = ()
     tapped: tuple = ()
+    dowels: tuple = ()   # ``(x, y, diameter)`` reamed through both flange halves
 
     @property
     def solid(self):
@@ -184,6 +185,8 @@ class SplitHousing:
                        * (self.floor_wall if wall == "floor" else self.roof_wall))
         for x, y, diameter, depth, _ in self.tapped:
             volume -= signed_area(circle(diameter / 2, TAPPED_SEGMENTS, (x, y))) * depth
+        for x, y, diameter in self.dowels:
+            volume -= signed_area(circle(diameter / 2, TAPPED_SEGMENTS, (x, y))) * flange_height
         return volume
 
 
