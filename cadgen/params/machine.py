@@ -100,5 +100,5 @@ class ManufacturingParameters(_Table):
         BeforeValidator(_list_to_tuple)] = Field(
         DEFAULT_BUILD_VOLUME,
         description="printer build volume [x, y, z], mm: every printed part's printing pose "
-                    "(largest flat face down, turned 90 deg about z if that fits) is checked "
-                    "against it")
+                    "(the resting face that leaves the least overhang among those that fit, "
+                    "turned 90 deg about z if that fits) is checked against it")

@@ -318,6 +318,14 @@ def _solids_section(report: dict) -> str:
             _table(["part", "kind", "material", "instances", "volume (mm³)", "mass each (kg)",
                     "centre of mass (mm)", "triangles", "watertight"], rows,
                    numeric=(3, 4, 5, 7), empty="no parts")]
+    printed = [p for p in solids.get("parts", []) if p.get("overhang_mm2") is not None]
+    if printed:   # each printed part on the face that leaves the least unsupported overhang
+        body.append("<h3>Printing: overhang steeper than 45° in each part's printing pose</h3>"
+                    + _table(["part", "overhang (mm²)", "supports"],
+                             [[_e(p["part"]), _e(_number(p["overhang_mm2"], 0)),
+                               _badge("warn") + " needed" if p["supports_needed"]
+                               else _badge("pass") + " none"] for p in printed],
+                             numeric=(1,)))
     enclosure, classes = [], []
     for r in solids.get("enclosure", []):
         ok = r.get("gears_enclosed", True) and r.get("axial_fit", True)

@@ -235,6 +235,14 @@ def format_solids(solids: dict) -> str:
         else:
             lines.append(f"     no parts overlap ({overlaps['pairs_examined']} touching pairs "
                          "intersected; only their fits' chord-error shells)")
+    printed = [p for p in parts if p.get("overhang_mm2") is not None]
+    if printed:
+        needing = [p for p in printed if p.get("supports_needed")]
+        worst = max(printed, key=lambda p: p["overhang_mm2"])
+        lines.append(f"     printing: {len(needing)} of {len(printed)} printed parts need supports"
+                     + (f" (overhang up to {_number(worst['overhang_mm2'], '.0f')} mm2, "
+                        f"{worst['part']})" if needing else "")
+                     + "; each on the face that leaves the least overhang")
     alignment = solids.get("alignment") or []
     if alignment:
         worst = max(alignment, key=lambda row: row["misalignment_arcmin"])

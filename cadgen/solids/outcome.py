@@ -18,7 +18,7 @@ import numpy as np
 from cadgen.params.machine import DEFAULT_BUILD_VOLUME
 
 __all__ = ["SolidsOutcome", "solids_outcome", "solids_report", "enclosure_checks",
-           "printing_pose", "fits_build_volume", "SUPPORT_RTOL", "FACE_AREA_RTOL",
+           "printing_pose", "resting_faces", "fits_build_volume", "SUPPORT_RTOL", "FACE_AREA_RTOL",
            "FOOTPRINT_AREA_RTOL"]
 
 #: A facet lies on a supporting plane of the part (the part can rest on it) when no
@@ -47,6 +47,7 @@ class SolidsOutcome:
     process: str = "machined"                    # [manufacturing] process: parts' materials
     segments: int = 96                           # polygons per circle (the overlaps' chord)
     _poses: dict = field(default_factory=dict, repr=False)
+    _overhangs: dict = field(default_factory=dict, repr=False)   # printed parts' (mm^2)
     _printed: dict = field(default_factory=dict, repr=False)   # part name -> printing mesh
     _made: dict = field(default_factory=dict, repr=False)   # what once() computed, by key
 
@@ -58,10 +59,32 @@ class SolidsOutcome:
         return self._made[key]
 
     def printing_pose(self, part) -> np.ndarray:
-        """The part's printing pose (see :func:`printing_pose`), computed once per part."""
+        """The part's printing pose, computed once per part: a printed part on the resting face
+        with the least overhang that fits the printer (:mod:`cadgen.solids.printing`), any other
+        on its largest flat face (:func:`printing_pose`)."""
         if part.name not in self._poses:
-            self._poses[part.name] = printing_pose(part.mesh)
+            if self.printed(part):
+                from cadgen.solids.printing import least_overhang_pose
+
+                pose, overhang = least_overhang_pose(part.mesh, self.build_volume)
+                self._poses[part.name], self._overhangs[part.name] = pose, overhang
+            else:
+                self._poses[part.name] = printing_pose(part.mesh)
         return self._poses[part.name]
+
+    def printed(self, part) -> bool:
+        """Whether the part is printed (its material's process), not bought or machined."""
+        from cadgen.machine.fits import FitError, process_fits
+
+        try:
+            return process_fits(self.process).material(part.kind).process == "printed"
+        except FitError:   # not a made part (the soil, a bought sprocket)
+            return False
+
+    def overhang(self, part) -> float | None:
+        """A printed part's overhang area in its printing pose (mm^2), None for another."""
+        self.printing_pose(part)
+        return self._overhangs.get(part.name)
 
     def printing_mesh(self, part):
         """A copy of the part's mesh in its printing pose (what its STL holds), made once per
@@ -165,8 +188,21 @@ def _footprint_turn(points) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def resting_faces(mesh, *, support_rtol: float = SUPPORT_RTOL) -> list:
+    """``[(area, unit outward normal)]`` of the flat faces a part can rest on (no vertex beyond
+    their plane), largest first."""
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    tolerance = support_rtol * max(float(mesh.scale), 1.0)
+    areas, normals, points = _flat_faces(mesh)
+    out = []
+    for index in np.argsort(-areas, kind="stable"):
+        if np.max((vertices - points[index]) @ normals[index]) <= tolerance:
+            out.append((float(areas[index]), normals[index] / np.linalg.norm(normals[index])))
+    return out
+
+
 def printing_pose(mesh, *, support_rtol: float = SUPPORT_RTOL,
-                  area_rtol: float = FACE_AREA_RTOL) -> np.ndarray:
+                  area_rtol: float = FACE_AREA_RTOL, normal=None) -> np.ndarray:
     """4x4 rigid transform putting a part on a printer bed: largest flat face down, on z = 0.
 
     The face is the largest by area among the mesh's flat faces (coplanar adjacent
@@ -180,12 +216,16 @@ def printing_pose(mesh, *, support_rtol: float = SUPPORT_RTOL,
     ----------
     mesh : trimesh.Trimesh
         A closed part, mm.
+    normal : (3,) float, optional
+        The outward normal of the face to rest on (one of :func:`resting_faces`) instead.
 
     Returns
     -------
     (4, 4) float
     """
     vertices = np.asarray(mesh.vertices, dtype=float)
+    if normal is not None:
+        return _posed(vertices, vertices, np.asarray(normal, dtype=float))
     if len(mesh.faces) == 0 or not np.isfinite(vertices).all():
         raise ValueError(f"a printing pose needs a finite mesh with faces, not {len(mesh.faces)} "
                          f"faces")
@@ -209,6 +249,12 @@ def printing_pose(mesh, *, support_rtol: float = SUPPORT_RTOL,
         normal = hull_normals[int(np.argmax(hull_areas))]
     else:
         normal = normals[best]
+    return _posed(vertices, extreme, normal)
+
+
+def _posed(vertices, extreme, normal) -> np.ndarray:
+    """The face of outward ``normal`` turned onto -z, the footprint squared, the part on z = 0
+    and centred on x = y = 0."""
     transform = np.eye(4)
     transform[:3, :3] = _turn_onto(normal / np.linalg.norm(normal))
     transform[:3, :3] = _footprint_turn((extreme @ transform[:3, :3].T)[:, :2]) @ transform[:3, :3]
@@ -326,6 +372,7 @@ def solids_report(outcome: SolidsOutcome) -> dict:
 def _solids_report(outcome: SolidsOutcome) -> dict:
     from cadgen.machine.fits import process_fits
     from cadgen.solids.mass import mass_properties
+    from cadgen.solids.printing import SUPPORT_FREE_MM2
 
     parts = []
     too_big = []
@@ -345,8 +392,11 @@ def _solids_report(outcome: SolidsOutcome) -> dict:
         fits = fits_build_volume(extents, outcome.build_volume) if printed else None
         if printed and not fits:
             too_big.append({"part": part.name, "kind": part.kind, "print_extents_mm": extents})
+        overhang = outcome.overhang(part) if printed else None
         parts.append({
             "part": part.name, "kind": part.kind, "instances": len(instances),
+            "overhang_mm2": overhang,
+            "supports_needed": None if overhang is None else overhang > SUPPORT_FREE_MM2,
             "file": f"solids/{part.name}.stl", "triangles": int(len(part.mesh.faces)),
             "volume_mm3": props["volume_mm3"], "area_mm2": props["area_mm2"],
             "material": material.name, "process": material.process, "density_kg_m3": density,
