@@ -216,6 +216,34 @@ def test_the_reports_joint_table_says_each_item_once_with_its_count():
     from cadgen.report.html_machine import _joint_graph_html
 
     html = _joint_graph_html(model_report(small_machine()))
+    html = html.split("assembly order")[0]   # the joints' table (the order repeats the items)
     # the shaft's two seats' bearings are one line of two; the keys one each
     assert "2 x deep-groove ball bearing 6002-2Z (15 x 32 x 9 mm)" in html
     assert html.count("1 x parallel key DIN 6885 A 5 x 5 x 20") == 2
+
+
+def test_the_assembly_order_puts_every_joint_once_and_in_a_workshops_order(paper_assembly):
+    from cadgen.assembly.sequence import TIGHTENING_TORQUE_NM, assembly_sequence
+
+    _, _, _, assembly, _ = paper_assembly
+    model = assembly.model
+    steps = assembly_sequence(model)
+    holding = [j for j in model.joints if j.kind in ("fixed", "revolute")]
+    assert [s["step"] for s in steps] == list(range(1, len(holding) + 1))
+    assert Counter((tuple(sorted((s["part"], s["onto"]))), s["how"]) for s in steps) == Counter(
+        (tuple(sorted((j.a, j.b))), j.detail) for j in holding)   # every holding joint, once
+    when = {(s["part"], s["onto"]): s["step"] for s in steps}
+    into = {s["part"]: s["step"] for s in steps if s["onto"].startswith(("gearbox", "frame"))
+            and s["part"].startswith("shaft-") and s["joint"] == "revolute"}
+    gears = {name for p in assembly.parts if p.kind == "gear" for name, _, _ in p.instances}
+    for (part, onto), step in when.items():
+        if onto in into and part in gears:
+            assert step < into[onto], (part, onto)   # a gear onto its shaft before the shaft goes in
+    for (part, onto), step in when.items():
+        if "-cover" in part and onto.endswith(("base", "arm1", "arm2")):
+            shafts = [s["step"] for s in steps if s["onto"] == onto and s["joint"] == "revolute"]
+            assert shafts and max(shafts) < step, onto   # closed after its shafts are in
+    # the flange bolts' torque, 8.8 at mu 0.14: gearbox 2's M4 at 3 N m
+    cover = next(s for s in steps if s["part"] == "gearbox2-cover-arm1")
+    assert any("M4" in b and f"{TIGHTENING_TORQUE_NM['M4']:g} N m" in b for b in cover["bought"])
+    assert TIGHTENING_TORQUE_NM["M4"] == 3.0 and TIGHTENING_TORQUE_NM["M6"] == 10.1

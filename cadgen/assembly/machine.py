@@ -293,4 +293,8 @@ def model_report(model: AssemblyModel, expected: int = 1) -> dict:
     problems = model.degrees_of_freedom_check(expected=expected)
     report["problems"] = problems
     report["passed"] = not problems
+    if model.placements:   # the solids' model: the order a fitter puts it together in
+        from cadgen.assembly.sequence import assembly_sequence
+
+        report["sequence"] = assembly_sequence(model)
     return report

@@ -265,6 +265,15 @@ def _joint_graph_html(assembly) -> str:
         body += (f"<details><summary>every joint and what it is bought with ({len(joints)})"
                  "</summary>" + _table(["kind", "part", "held by", "what makes it",
                                         "bought items"], rows) + "</details>")
+    sequence = assembly.get("sequence") or []
+    if sequence:
+        items = "".join(
+            f"<li>{_e(step['part'])} onto {_e(step['onto'])}: {_e(step['how'])}"
+            + (f" <span class=\"note\">({_e('; '.join(step['bought']))})</span>"
+               if step["bought"] else "") + "</li>" for step in sequence)
+        body += (f"<details><summary>assembly order ({len(sequence)} steps: each shaft's gears, "
+                 "the housings outward from the frame, each closed after its shafts, then the "
+                 "parts outside)</summary><ol>" + items + "</ol></details>")
     not_made = assembly.get("not_made") or []
     if not_made:
         body += ("<details><summary>joints in the graph not yet made as parts "
