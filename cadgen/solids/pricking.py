@@ -242,9 +242,9 @@ def _rocker_and_needle(params, link, needle, *, z0, segments, hub=None, clamp=No
 
     linkage = params.linkage
     half = linkage.rocker_width / 2
-    hub_radius = max(half, hub["outside"] / 2) if hub else half
-    rocker = extrude(hull_of_circles([(0.0, 0.0, hub_radius), (link.rocker, 0.0, half)],
-                                     segments),
+    # the bar's own end at B stays its half width: the hub's boss (wider) stands round it, and
+    # two coincident cylinders would leave the union's walls with zero-area slivers
+    rocker = extrude(hull_of_circles([(0.0, 0.0, half), (link.rocker, 0.0, half)], segments),
                      linkage.rocker_thickness, z0=z0, path="linkage.rocker_thickness",
                      outline_path="rocker outline")
     if hub:
