@@ -55,10 +55,12 @@ def bolt_circle(bolted: dict, centre=(0.0, 0.0)) -> list:
             for k in range(count)]
 
 
-def flange_problems(name: str, carries: str, torque_nmm: float, flange: dict) -> list:
+def flange_problems(name: str, carries: str, torque_nmm: float, flange: dict, *,
+                    path: str = "machine.shafts", code: str = "flange_bolts_overloaded") -> list:
     """A carrying flange's screws in shear: ``tau = T / (n A_s r)`` (each screw at the bolt circle
     radius ``r``) against ``FLANGE_SHEAR_ALLOW``, about half an 8.8 screw's shear yield (0.577 x
-    640 MPa), the service factor already in T. The result rides on ``flange``."""
+    640 MPa), the service factor already in T. The result rides on ``flange``; a problem is
+    reported at ``path`` with ``code`` (a plate screwed on, the cam, says its own)."""
     # ISO 898-1's stress area: pi / 4 ((d2 + d3) / 2)^2, d2 = d - 0.6495 P, d3 = d - 1.2269 P
     bolt, pitch = float(flange["bolt"].removeprefix("M")), socket_screw(flange["bolt"])["pitch"]
     area = math.pi / 4 * ((2 * bolt - 1.8764 * pitch) / 2) ** 2
@@ -68,7 +70,7 @@ def flange_problems(name: str, carries: str, torque_nmm: float, flange: dict) ->
     flange["bolt_shear_allow_mpa"] = FLANGE_SHEAR_ALLOW
     if stress <= FLANGE_SHEAR_ALLOW:
         return []
-    return [Problem("machine.shafts", "flange_bolts_overloaded",
+    return [Problem(path, code,
                     f"the flange of {name} ({flange['bolts']} x {flange['bolt']}) "
                     f"carrying {carries} shears its screws at {stress:.0f} MPa, above "
                     f"{FLANGE_SHEAR_ALLOW:g} MPa")]

@@ -21,7 +21,9 @@ import math
 
 from kinematics.errors import Problem
 
-from cadgen.machine.catalogue import CatalogueError, key_lengths, screw_length, socket_screw
+from cadgen.machine.catalogue import (CatalogueError, clearance_hole, key_lengths, screw_length,
+                                     socket_screw)
+from cadgen.machine.fastening import flange_problems
 from cadgen.machine.shafts import KEYLESS_BELOW, FLAT_DEPTH_RATIO, key_for_shaft, key_pressure
 
 __all__ = ["keyed_hub", "screwed_plate", "needle_clamp", "arm_fixings", "fixings_report",
@@ -53,8 +55,6 @@ NEEDLE_SLIDE = 0.05
 PLATE_THREADS, PLATE_SCREWS = ("M3", "M4", "M5"), 3
 #: A screw's thread engages this many diameters in an aluminium housing's tapped hole.
 ENGAGEMENT = 1.5
-#: The plate's screws (8.8) in shear: allowed stress, MPa (as the carrying flanges').
-SHEAR_ALLOW = 190.0
 
 
 def keyed_hub(part: str, shaft: str, d: float, torque_nmm: float, min_length: float,
@@ -105,14 +105,17 @@ def keyed_hub(part: str, shaft: str, d: float, torque_nmm: float, min_length: fl
 
 
 def screwed_plate(part: str, carries: str, seat_radius: float, thickness: float,
-                  torque_nmm: float, tapped_depth: float, path: str) -> tuple[dict, list]:
+                  torque_nmm: float, tapped_depth: float, path: str, *,
+                  hole_series: str = "medium", hole_extra: float = 0.0) -> tuple[dict, list]:
     """``part`` (a plate of ``thickness``) screwed onto ``carries`` round a bearing seat.
 
     The smallest thread of :data:`PLATE_THREADS` whose sunk head leaves at least 0.8 d of plate
     under it, :data:`PLATE_SCREWS` of them on the smallest circle whose tapped holes keep
     :data:`WALL_MIN` from the seat (``seat_radius``), their shear under ``torque_nmm`` checked
-    as the carrying flanges' are. ``tapped_depth``: how deep the housing's wall can be tapped.
-    The plate must reach ``covers_radius`` (its counterbores and a wall): the caller checks.
+    as the carrying flanges' are (:func:`cadgen.machine.fastening.flange_problems`).
+    ``tapped_depth``: how deep the housing's wall can be tapped; ``hole_series`` and
+    ``hole_extra``: the process's ISO 273 clearance holes. The plate must reach
+    ``covers_radius`` (its counterbores and a wall): the caller checks.
     """
     problems = []
     for thread in PLATE_THREADS:
@@ -136,30 +139,18 @@ def screwed_plate(part: str, carries: str, seat_radius: float, thickness: float,
     if length > clamp + tapped_depth + 1e-9:   # a standard length would bottom in its hole
         shorter = [n for n in screw["lengths"] if n <= clamp + tapped_depth + 1e-9]
         length = shorter[-1] if shorter else length
-    pitch = screw["pitch"]
-    area = math.pi / 4 * ((2 * size - 1.8764 * pitch) / 2) ** 2   # ISO 898-1 stress area
-    shear = float(torque_nmm) / (PLATE_SCREWS * area * circle)
     plate = {"part": part, "carries": carries, "bolt": thread, "bolts": PLATE_SCREWS,
              "bolt_circle_radius": circle, "bolt_phase": math.pi / 2,
              "counterbore_diameter": COUNTERBORE[thread], "counterbore_depth": depth,
-             "clearance_hole": _clearance(thread), "tap_drill": TAP_DRILL[thread],
-             "tapped_depth": float(tapped_depth), "screw_length": length,
-             "screw": f"ISO 4762 {thread} x {length:g} - 8.8",
+             "clearance_hole": clearance_hole(thread, hole_series) + hole_extra,
+             "tap_drill": TAP_DRILL[thread], "tapped_depth": float(tapped_depth),
+             "screw_length": length, "screw": f"ISO 4762 {thread} x {length:g} - 8.8",
              "covers_radius": circle + COUNTERBORE[thread] / 2 + WALL_MIN,
-             "torque_nm": float(torque_nmm) / 1000.0, "bolt_shear_mpa": shear,
-             "bolt_shear_allow_mpa": SHEAR_ALLOW}
-    if shear > SHEAR_ALLOW:
-        problems.append(Problem(path, "plate_screws_overloaded",
-                                f"the {part}'s {PLATE_SCREWS} x {thread} screws shear at "
-                                f"{shear:.0f} MPa under {torque_nmm / 1000:.1f} N m, above "
-                                f"{SHEAR_ALLOW:g} MPa"))
+             "torque_nm": float(torque_nmm) / 1000.0}
+    # the screws' shear, as a carrying flange's (it sets bolt_shear_mpa and its allowance)
+    problems += flange_problems(f"the {part}", carries, float(torque_nmm), plate, path=path,
+                                code="plate_screws_overloaded")
     return plate, problems
-
-
-def _clearance(thread: str) -> float:
-    from cadgen.machine.catalogue import clearance_hole
-
-    return clearance_hole(thread)
 
 
 def needle_clamp(needle_diameter: float, holder_length: float, fit_clearance: float,
@@ -269,7 +260,8 @@ def arm_fixings(params, shafts, stacks, fits, cam=None) -> tuple[list, dict, lis
         screwed, found = screwed_plate("cam", "gearbox2", seat.seat_diameter / 2,
                                        params.cam.thickness,
                                        design_load(machine) * float(radii.max()), tapped,
-                                       "cam.thickness")
+                                       "cam.thickness", hole_series=fits.bolt_hole_series,
+                                       hole_extra=fits.bolt_hole_extra)
         problems += found
         if screwed["covers_radius"] > float(radii.min()) + 1e-9:
             problems.append(Problem("cam.base_radius", "cam_too_small_for_screws",
