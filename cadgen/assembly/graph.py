@@ -59,12 +59,14 @@ class Item:
 @dataclass(frozen=True)
 class Placement:
     """One placed copy of a made part: ``instance`` (a part of the graph) is the file ``part``
-    riding on the kinematic ``body`` at carrier angle plus ``phase`` (rad)."""
+    riding on the kinematic ``body`` at carrier angle plus ``phase`` (rad); ``kind`` is the
+    part's (``"gear"``, ``"shaft"``, ``"housing"``, ... as the solids say; empty if unknown)."""
 
     instance: str
     part: str
     body: str
     phase: float = 0.0
+    kind: str = ""
 
     def as_tuple(self) -> tuple:
         """``(instance, body, phase)``, as a solid part lists its instances."""
@@ -337,7 +339,7 @@ class AssemblyModel:
             "unconnected": self.unconnected(),
             "bodies": [[p for p in self.parts if p in body] for body in self.bodies()],
             "placements": [{"instance": p.instance, "part": p.part, "body": p.body,
-                            "phase_deg": round(math.degrees(p.phase), 9)}
+                            "phase_deg": round(math.degrees(p.phase), 9), "kind": p.kind}
                            for p in self.placements],
         }
 

@@ -56,9 +56,10 @@ class _Builder:
     ``bodies``: ``{made part: kinematic body}``; None builds the graph alone (no placements).
     """
 
-    def __init__(self, bodies=None, housings=None):
+    def __init__(self, bodies=None, housings=None, kinds=None):
         self.parts, self.joints, self.placements, self.made = [], [], [], []
         self.bodies = bodies
+        self.kinds = kinds or {}
         self.housings = housings or {}
         self._placed = set()
 
@@ -71,7 +72,8 @@ class _Builder:
             self.made.append(name)
         if self.bodies is not None and stem in self.bodies and name not in self._placed:
             suffix, phase = COPIES[copy]
-            self.placements.append(Placement(name, stem, self.bodies[stem] + suffix, phase))
+            self.placements.append(Placement(name, stem, self.bodies[stem] + suffix, phase,
+                                             self.kinds.get(stem, "")))
             self._placed.add(name)
         return name
 
@@ -145,16 +147,18 @@ def _flange_items(flange) -> tuple:
     return screw_items(flange["bolt"], float(flange["thickness"]), int(flange["bolts"]))
 
 
-def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> AssemblyModel:
+def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None,
+                   kinds=None) -> AssemblyModel:
     """The planting machine's assembly model: frame, drive, gearbox 1 and both arms.
 
     ``meshes``: the gear train's ``(drive, driven)`` gear names of every pair (the stages'
     ``pair.names``); each becomes a gear joint between the gears' instances. ``bodies``: the
     made parts' kinematic bodies (``{part.name: part.body}`` of the solids), to place their
     copies; ``housings``: ``{"gearbox1": record, "gearbox2": ..., "frame": ...}`` split
-    housing records, whose flange bolts (and splices) their joints then carry.
+    housing records, whose flange bolts (and splices) their joints then carry; ``kinds``: the
+    made parts' kinds, which the placements keep.
     """
-    b = _Builder(bodies, housings)
+    b = _Builder(bodies, housings, kinds)
     frame = b.housing("frame")
     box1 = b.housing("gearbox1")
     box2 = {arm: b.housing("gearbox2", f"arm{arm}") for arm in (1, 2)}
@@ -228,13 +232,15 @@ def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> Asse
     return b.model(frame)
 
 
-def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None) -> AssemblyModel:
+def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None,
+                   kinds=None) -> AssemblyModel:
     """The pricking machine's assembly model: the frame bracket holding the sun's shaft by its
     stub's key, the gear case turning on that shaft and driven by the sprocket bolted to it,
     the intermediate and planet shafts in the case, the rocker and needle on the planet.
-    ``bodies`` and ``housings`` (``{"gear-case": record}``) as for :func:`planting_model`."""
+    ``bodies``, ``housings`` (``{"gear-case": record}``) and ``kinds`` as for
+    :func:`planting_model`."""
     held = drivetrain.rules.get("case_drive")
-    b = _Builder(bodies, housings)
+    b = _Builder(bodies, housings, kinds)
     frame = b.instance("frame-bracket")
     case = b.housing("gear-case")
     gears = {}

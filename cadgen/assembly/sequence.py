@@ -46,18 +46,16 @@ def _items(joint) -> list:
     return [f"{n} x {description}{torque}" for (description, torque), n in counts.items()]
 
 
-def _is_gear_on_shaft(joint) -> bool:
-    return joint.b.startswith("shaft-") and not joint.a.startswith(("shaft-", "gearbox", "frame",
-                                                                    "gear-case", "cam", "planter",
-                                                                    "rocker", "needle",
-                                                                    "input-coupling",
-                                                                    "case-sprocket", "blade"))
+def _is_gear_on_shaft(joint, kinds: dict) -> bool:
+    """A gear keyed to, or run on its bearings on, its shaft (the placements' kinds say which)."""
+    return {kinds.get(joint.a), kinds.get(joint.b)} == {"gear", "shaft"}
 
 
 def assembly_sequence(model) -> list[dict]:
     """The numbered steps (``step``, ``part``, ``onto``, ``joint``, ``how``, ``bought``) that put
     ``model``'s machine together (see the module notes); every holding joint once."""
     holding = [j for j in model.joints if j.kind in ("fixed", "revolute")]
+    kinds = {p.instance: p.kind for p in model.placements}
     done, steps = set(), []
 
     def add(joint, part, onto):
@@ -68,8 +66,10 @@ def assembly_sequence(model) -> list[dict]:
                       "how": joint.detail, "bought": _items(joint)})
 
     for joint in holding:   # 1. each shaft's sub-assembly
-        if _is_gear_on_shaft(joint):
-            add(joint, joint.a, joint.b)
+        if _is_gear_on_shaft(joint, kinds):
+            gear, shaft = ((joint.a, joint.b) if kinds.get(joint.a) == "gear"
+                           else (joint.b, joint.a))
+            add(joint, gear, shaft)
     # 2. the housings outward from the frame, each base's shafts before its cover. A frame that
     # is no housing (the pricking machine's bracket) takes the assembled machine last: the walk
     # starts at the first housing's base and the frame's joints are the final steps
@@ -98,7 +98,7 @@ def assembly_sequence(model) -> list[dict]:
         joints = neighbours.get(base, [])
         for joint in joints:   # splices, shafts in the base, flanges bolted to it
             other = joint.b if joint.a == base else joint.a
-            if "-cover" in other or _is_gear_on_shaft(joint):
+            if "-cover" in other or _is_gear_on_shaft(joint, kinds):
                 continue
             if other.startswith("shaft-") or "splice" in joint.detail:
                 add(joint, other, base)

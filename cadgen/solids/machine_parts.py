@@ -123,12 +123,12 @@ def with_dowels(housing):
     low, high = housing.flange_z
     pins = dowel_pins(housing.bolt_size, high - low)
     radius = pins["diameter"] / 2
-    holes = None
+    holes, dowels = None, ()
     for x, y in dowel_positions(housing):
         hole = m3d.Manifold.cylinder(high - low + 2.0, radius, radius, TAPPED_SEGMENTS
                                      ).translate((x, y, low - 1.0))
         holes = hole if holes is None else holes + hole
-    dowels = tuple((x, y, pins["diameter"]) for x, y in dowel_positions(housing))
+        dowels += ((x, y, pins["diameter"]),)
     return replace(housing, base=housing.base - holes, cover=housing.cover - holes,
                    dowels=dowels)
 

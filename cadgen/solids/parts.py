@@ -115,7 +115,7 @@ def placed_assembly(parts, body_pose, build_model, drivetrain, train, housings) 
     """
     meshes = [tuple(stage.generated.pair.names) for stage in (train.stages if train else ())]
     model = build_model(drivetrain, meshes, bodies={part.name: part.body for part in parts},
-                        housings=housings)
+                        housings=housings, kinds={part.name: part.kind for part in parts})
     for part in parts:
         part.instances = model.instances_of(part.name)
     for body in dict.fromkeys(p.body for p in model.placements):
