@@ -255,11 +255,13 @@ def test_planting_names_positions_and_stack():
     top = train.bases["gearbox2"] + train.stacks["gearbox2"].cavity_height + \
         inner.seats[1].bearing.width
     assert inner.ends == pytest.approx((-inner.seats[0].bearing.width, top))
-    # E reaches through the cam (seated on the roof), the gap and the planter's keyed hub
+    # E reaches through the cam (seated on the roof), the gap and the planter's keyed hub,
+    # and on past the hub for its DIN 471 ring: groove m = 1.1 and n = 1.1 beyond it (DIN 471
+    # for 15 mm), rounded up to 2.5 mm
     hub = train.fixings["planter"]
     assert hub["length"] >= params.planter.arm_thickness
     assert shaft.extends_above == pytest.approx(params.cam.thickness + params.housing.axial_gap
-                                                + hub["length"])
+                                                + hub["length"] + 2.5)
 
 
 def test_planting_speeds_follow_the_train():
@@ -298,6 +300,8 @@ def test_an_impossible_diameter_is_a_named_problem(tmp_path):
     codes = {(p.path, p.code) for p in train.problems}
     assert ("machine.shafts.E", "shaft_too_weak") in codes
     assert ("machine.shafts.D", "shaft_not_catalogue") in codes
+    # DIN 471 has no ring in the table for 22 mm: said, not guessed
+    assert ("machine.shafts.D.diameter", "no_retaining_ring") in codes
 
 
 def test_printed_process_gives_printed_seats(tmp_path):

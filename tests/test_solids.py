@@ -59,8 +59,9 @@ def test_every_part_is_a_closed_positive_volume(which, request):
         assert mesh.is_watertight and mesh.is_winding_consistent, part.name
         assert mesh.volume > 0, part.name
         kinds.add(part.kind)
-    expected = ({"gear", "housing", "shaft", "cam", "planter", "blade", "ground"}
-                if which == "planting" else {"gear", "housing", "shaft", "rocker", "needle", "ground",
+    expected = ({"gear", "housing", "shaft", "spacer", "cam", "planter", "blade", "ground"}
+                if which == "planting" else {"gear", "housing", "shaft", "spacer", "rocker", "needle",
+                                             "ground",
                                              "sprocket"})
     assert kinds == expected
 

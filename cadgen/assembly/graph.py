@@ -150,6 +150,7 @@ class AssemblyModel:
     frame: str = "frame"
     placements: tuple[Placement, ...] = ()
     made: tuple[str, ...] = ()
+    axial: object = field(default=None, compare=False, repr=False)   # assembly.axial.AxialGraph
     _body_index: dict = field(init=False, repr=False, compare=False, hash=False)
 
     def __post_init__(self):

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import re
 
+from cadgen.assembly.axial import AxialGraph, axial_check, free_message
 from cadgen.assembly.graph import AssemblyModel, Item, Joint, Placement
 from cadgen.assembly.items import (bearing_item, bolted_flange_items, dowel_items, key_item,
                                    screw_items, sprocket_items)
@@ -62,6 +63,7 @@ class _Builder:
         self.kinds = kinds or {}
         self.housings = housings or {}
         self._placed = set()
+        self.axial = AxialGraph()
 
     def instance(self, stem: str, copy: str | None = None) -> str:
         """The instance name of ``stem``'s ``copy``, placed when ``stem`` is a made part."""
@@ -120,7 +122,7 @@ class _Builder:
                 raise ValueError(f"the assembly model places no copy of the made parts {missing}")
         parts = [frame] + [p for p in self.parts if p != frame]
         return AssemblyModel(tuple(parts), tuple(self.joints), frame, tuple(self.placements),
-                             tuple(self.made))
+                             tuple(self.made), self.axial)
 
 
 def _bearings(shaft) -> str:
@@ -132,15 +134,61 @@ def _seat_items(shaft) -> tuple:
     return tuple(bearing_item(seat.bearing, getattr(seat, "count", 1)) for seat in shaft.seats)
 
 
-def _mount_joint(b, gear, shaft_instance, mount):
-    """A gear on its shaft: free on two bearings (a revolute), keyed, or on a D-flat."""
+def _mount_joint(b, gear, shaft_instance, mount, screw=None):
+    """A gear on its shaft: free on two bearings (a revolute), keyed, or on a D-flat; ``screw``:
+    the set screw that holds it along the shaft where no ring can (machine.retention)."""
+    extra = ((f"; held along the shaft by {screw} onto the key",
+              (Item("set screw", screw, screw, 1),)) if screw else ("", ()))
     if getattr(mount, "bearing", None) is not None:
         b.joint("revolute", gear, shaft_instance, f"runs free on 2 x {mount.bearing.designation}",
                 (bearing_item(mount.bearing, 2),))
     elif mount.key is not None:
-        b.joint("fixed", gear, shaft_instance, mount.key.designation, (key_item(mount.key),))
+        b.joint("fixed", gear, shaft_instance, mount.key.designation + extra[0],
+                (key_item(mount.key),) + extra[1])
     else:
-        b.joint("fixed", gear, shaft_instance, f"D-flat {mount.flat_depth:g} mm")
+        b.joint("fixed", gear, shaft_instance, f"D-flat {mount.flat_depth:g} mm" + extra[0],
+                extra[1])
+
+
+def _retention(drivetrain) -> dict:
+    """``{(shaft, side): ShaftRetention}`` of the drivetrain (empty before it was designed)."""
+    return {(r.shaft, r.side): r for r in getattr(drivetrain, "retention", ()) or ()}
+
+
+def _axial_stack(b, retention, shaft, me, copy, housing_of, parts_of):
+    """The shaft's spacers (made parts, clamped in its stack), its rings (bought with its
+    bearings' joint: returned) and its axial contacts (:mod:`cadgen.assembly.axial`).
+    ``housing_of(housing)`` is the housing's instance, ``parts_of``: ``{gear or hub name:
+    instance}``."""
+    if retention is None:
+        return ()
+    graph, nodes = b.axial, {}
+    graph.part(me)
+    for part in retention.parts:
+        if part.kind == "bearing":
+            seat = shaft.seats[part.ref]
+            node = graph.part(f"{me}/bearing-{part.ref + 1}",
+                              f"bearing {seat.bearing.designation} of {me} "
+                              f"({seat.housing}'s {seat.wall})")
+            housing = housing_of(seat.housing)
+            graph.rest(node, housing) if part.stop == "down" else graph.rest(housing, node)
+        elif part.kind == "ring":
+            node = graph.part(f"{me}/ring-{part.ref}", f"{part.designation} on {me}")
+        elif part.kind == "spacer":
+            node = b.instance(f"spacer-{shaft.name}-{part.ref}", copy)
+            graph.part(node, f"spacer {node}")
+            b.joint("fixed", node, me, f"spacer {part.z1 - part.z0:.2f} mm, clamped in the "
+                    "shaft's stack")
+        else:
+            node = graph.part(parts_of[part.ref])
+        if part.locked:
+            graph.fix(node, me)
+        nodes[id(part)] = node
+    for lower, upper in retention.touching():
+        graph.rest(nodes[id(upper)], nodes[id(lower)])
+    count = len(retention.rings)
+    return ((Item("retaining ring", retention.rings[0].designation,
+                  retention.rings[0].designation, count),) if count else ())
 
 
 def _flange_items(flange) -> tuple:
@@ -172,16 +220,21 @@ def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None,
         return f"arm{side}" if shaft.housing == "gearbox2" else f"side{side}"
 
     gear_instances = {}   # gear name -> {side: instance}
+    retention = _retention(drivetrain)
     for shaft in drivetrain.shafts:
         sides = (shaft.side,) if shaft.housing != "gearbox2" else (1, 2)
+        held = retention.get((shaft.name, shaft.side))
+        screws = dict(held.set_screws) if held is not None else {}
         for side in sides:
             me = b.instance(f"shaft-{shaft.name}", copy_of(shaft, side))
+            bearings = len(b.joints)
             b.joint("revolute", me, housing_part(shaft.seats[0].housing, side), _bearings(shaft),
                     _seat_items(shaft))
             if shaft.flange:   # a hollow shaft: in its bearing pair, bolted to what it carries
                 b.joint("fixed", me, housing_part(shaft.flange["carries"], side),
                         f"flange: {shaft.flange['bolts']} x {shaft.flange['bolt']} screws",
                         _flange_items(shaft.flange))
+                b.axial.fix(me, housing_part(shaft.flange["carries"], side))
             coupling = getattr(shaft, "coupling_key", None)
             if coupling is not None and side == 1:   # the user's sprocket or coupling hub
                 b.joint("fixed", "input-coupling", me,
@@ -199,7 +252,13 @@ def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None,
                 else:
                     gear = b.instance(stem, f"side{side}")
                 gear_instances.setdefault(mount.gear, {})[side] = gear
-                _mount_joint(b, gear, me, mount)
+                _mount_joint(b, gear, me, mount, screws.get(mount.gear))
+            parts_of = {gear: instances[side] for gear, instances in gear_instances.items()
+                        if side in instances}
+            parts_of["planter"] = f"planter-shell-arm{side}"
+            rings = _axial_stack(b, held, shaft, me, copy_of(shaft, side),
+                                 lambda housing, side=side: housing_part(housing, side), parts_of)
+            _add_items(b, bearings, rings + _hub_screw(screws, "planter"))
     for drive, driven in meshes:
         one, two = gear_instances.get(drive, {}), gear_instances.get(driven, {})
         for side in (1, 2):
@@ -244,19 +303,32 @@ def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None,
     frame = b.instance("frame-bracket")
     case = b.housing("gear-case")
     gears = {}
+    retention = _retention(drivetrain)
     for shaft in drivetrain.shafts:
         me = b.instance(f"shaft-{shaft.name}")
+        stack = retention.get((shaft.name, shaft.side))
+        screws = dict(stack.set_screws) if stack is not None else {}
         if shaft.name == "sun":   # the sun does not turn: its shaft's stub keyed in the bracket
             key = shaft.coupling_key
+            # and held along it by a set screw onto the key through the bracket's hub
+            from cadgen.machine.retention import set_screw
+
+            stub = set_screw(key)
             b.joint("fixed", me, frame,
-                    key.designation if key is not None
+                    f"{key.designation}, held by {stub} onto it" if key is not None
                     else "stub in the bracket: " + NOT_MADE[0] + " (key)",
-                    (key_item(key),) if key is not None else ())
+                    (key_item(key), Item("set screw", stub, stub, 1)) if key is not None else ())
+            if key is not None:
+                b.axial.fix(me, frame)
+        bearings = len(b.joints)
         b.joint("revolute", me, case, _bearings(shaft), _seat_items(shaft))
         for mount in shaft.mounts:
             gear = b.instance(_slug(mount.gear))
             gears[mount.gear] = gear
-            _mount_joint(b, gear, me, mount)
+            _mount_joint(b, gear, me, mount, screws.get(mount.gear))
+        rings = _axial_stack(b, stack, shaft, me, None, lambda housing: case,
+                             {**gears, "rocker": "rocker"})
+        _add_items(b, bearings, rings + _hub_screw(screws, "rocker"))
     if held:
         sprocket = held["sprocket"]
         b.joint("fixed", b.instance("case-sprocket"), case,
@@ -278,6 +350,19 @@ def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None,
     return b.model(frame)
 
 
+def _add_items(b, index: int, items: tuple) -> None:
+    """Add ``items`` to the joint at ``index`` (a shaft's bearings: its rings are bought with
+    them)."""
+    if items:
+        joint = b.joints[index]
+        b.joints[index] = Joint(joint.kind, joint.a, joint.b, joint.detail,
+                                joint.items + tuple(items))
+
+
+def _hub_screw(screws: dict, hub: str) -> tuple:
+    return (Item("set screw", screws[hub], screws[hub], 1),) if hub in screws else ()
+
+
 def _hub_joint(hub, where: str) -> tuple:
     """``(detail, items)`` of a part keyed (or D-flatted) to its shaft by its hub
     (:func:`cadgen.machine.fixings.keyed_hub`), or not yet made."""
@@ -297,6 +382,9 @@ def model_report(model: AssemblyModel, expected: int = 1) -> dict:
     report["not_made"] = [f"{j.kind} {j.a} - {j.b}: {j.detail}" for j in model.joints
                           if NOT_MADE[0] in j.detail]
     problems = model.degrees_of_freedom_check(expected=expected)
+    if getattr(model, "axial", None) is not None and model.axial.parts:
+        report["axial"] = axial_check(model.axial, model.frame)
+        problems += [free_message(entry) for entry in report["axial"]["free"]]
     report["problems"] = problems
     report["passed"] = not problems
     if model.placements:   # the solids' model: the order a fitter puts it together in

@@ -17,7 +17,7 @@ from cadgen.machine.model import Bearing, KeySize
 
 __all__ = ["CatalogueError", "bearings", "bearings_with_bore", "key_for_shaft", "key_length",
            "key_lengths", "clearance_hole", "socket_screw", "screw_length", "nut", "washer",
-           "preferred_diameters", "SERIES"]
+           "preferred_diameters", "shaft_ring", "SERIES"]
 
 #: ISO 273's clearance-hole series.
 SERIES = ("fine", "medium", "coarse")
@@ -132,3 +132,18 @@ def washer(thread: str) -> dict:
     row = _by_thread("washers", thread)
     return {"thread": thread, "d1": float(row["d1"]), "d2": float(row["d2"]),
             "h": float(row["h"])}
+
+
+# ------------------------------------------------------------------ retaining rings
+def shaft_ring(d: float) -> dict:
+    """DIN 471 retaining ring for a shaft of diameter ``d`` (mm): ``{d1, s (thickness), d2
+    (groove diameter), m (groove width), n (shaft beyond the groove), d4 (space the fitted
+    ring needs), designation}``."""
+    for row in _rows("retaining_rings"):
+        if abs(float(row["d1"]) - float(d)) < 1e-9:
+            ring = {name: float(value) for name, value in row.items()}
+            ring["designation"] = f"retaining ring DIN 471 {ring['d1']:g} x {ring['s']:g}"
+            return ring
+    sizes = ", ".join(row["d1"] for row in _rows("retaining_rings"))
+    raise CatalogueError(f"no DIN 471 retaining ring in the table for a {float(d):g} mm shaft "
+                         f"(it holds {sizes})")

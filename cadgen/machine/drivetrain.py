@@ -508,8 +508,14 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
         rules["stack_bases_mm"] = base
     if held is not None:
         rules["case_drive"] = held
+    from cadgen.machine.retention import shaft_retention
+
+    held = {"E": "planter", "planet": "rocker"}   # the arm's hub beyond its shaft's housing
+    retention = tuple(shaft_retention(s, stacks, base, fixings.get(held.get(s.name)),
+                                      params.housing.axial_gap) for s in shafts)
+    problems += [p for r in retention if r.side == 1 for p in r.problems]
     return Drivetrain(params.mechanism, tuple(shafts), stacks, fits.process, rules,
-                      tuple(problems), drive, base, fixings)
+                      tuple(problems), drive, base, fixings, retention)
 
 
 # ------------------------------------------------------------------ report

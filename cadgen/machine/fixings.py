@@ -240,7 +240,16 @@ def arm_fixings(params, shafts, stacks, fits, cam=None) -> tuple[list, dict, lis
     hub, found = keyed_hub(part, carrier, shaft.diameter, shaft.torque_nm * 1000.0, plate,
                            machine.key_pressure_mpa, fits.hub_allowance(shaft.diameter), path)
     fixings[part], problems = hub, problems + found
-    grown = hub["length"] - plate   # the shaft reaches through the hub, not only the plate
+    # the shaft reaches through the hub, not only the plate, and on past it for the ring
+    # that holds the hub up (machine.retention)
+    from cadgen.machine.catalogue import CatalogueError
+    from cadgen.machine.retention import ring_room
+
+    try:
+        hub["beyond"] = ring_room(shaft.diameter)
+    except CatalogueError:   # no ring for a diameter given off the table: retention says so
+        hub["beyond"] = 0.0
+    grown = hub["length"] - plate + hub["beyond"]
     shafts = [replace(s, extends_above=s.extends_above + grown) if s.name == carrier else s
               for s in shafts]
     if params.mechanism == "pricking":

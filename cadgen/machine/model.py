@@ -163,6 +163,7 @@ class Drivetrain:
     fixings: dict = field(default_factory=dict)   # part -> its fixing (machine.fixings):
     #                                                 the planter's and rocker's keyed hubs,
     #                                                 the cam's screws, the needle's clamp
+    retention: tuple = ()   # machine.retention.ShaftRetention of each shaft, as shafts
 
     def seats(self, housing: str) -> list:
         """The bearing seats of one housing, every side; a seat two shafts' records share (the

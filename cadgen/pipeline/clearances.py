@@ -44,8 +44,8 @@ import numpy as np
 __all__ = ["arm_groups", "arm_interference", "ground_clearance"]
 
 #: Part kinds enclosed by a housing of their own arm: not swept arm against arm (the housing
-#: around them is).
-_ENCLOSED_KINDS = frozenset({"gear"})
+#: around them is). The spacers fill gaps inside a cavity (machine.retention) by design.
+_ENCLOSED_KINDS = frozenset({"gear", "spacer"})
 #: The parts fixed in gearbox 2's body (the first group of :func:`_arm_part_bounds`).
 _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
 #: Gearbox 2's shafts, turning on their axes with their gears.

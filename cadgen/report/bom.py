@@ -56,7 +56,8 @@ def _made_rows(solids_report: dict, fits) -> list:
 
 _DESCRIPTIONS = {"gear": "gear", "housing": "gearbox housing half", "cam": "cam plate",
                  "planter": "planter (arm plate and duckbill tube)", "blade": "duckbill blade",
-                 "rocker": "rocker", "needle": "needle", "shaft": "shaft"}
+                 "rocker": "rocker", "needle": "needle", "shaft": "shaft",
+                 "spacer": "spacer (turned sleeve between the parts on a shaft)"}
 
 
 #: The bought rows' order: bearings, then keys, then the rest (screws, nuts, washers, the

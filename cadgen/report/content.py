@@ -200,8 +200,11 @@ def machine_section(params, drivetrain, train=None) -> dict:
     from cadgen.machine.drivetrain import drivetrain_report
     from cadgen.machine.fits import process_fits
 
+    from cadgen.machine.retention import retention_report
+
     section = drivetrain_report(drivetrain)
     section["fits"] = process_fits(params.manufacturing.process).as_dict()
+    section["retention"] = retention_report(getattr(drivetrain, "retention", ()) or ())
     rims = []
     for rim in (train.rims if train is not None else ()):
         thickness = None if math.isnan(rim.thickness) else float(rim.thickness)

@@ -127,6 +127,8 @@ def machine_section_html(report: dict) -> str:
             rows, numeric=(1, 2, 3)))
     body.append(_transmission_html(report))
     body.append(_fixings_html(machine.get("fixings") or {}))
+    body.append(_retention_html(machine.get("retention") or [],
+                                (report.get("assembly") or {}).get("axial")))
     body.append(_alignment_html((report.get("solids") or {}).get("alignment") or []))
     body.append(_joint_graph_html(report.get("assembly")))
     problems = machine.get("problems", [])
@@ -220,6 +222,42 @@ def _fixings_html(fixings: dict) -> str:
         return ""
     return ("<h3>How the arm's parts are fixed</h3>"
             + _table(["part", "fixing", "check", ""], rows))
+
+
+def _stack_words(part: dict) -> str:
+    """One part of a shaft's axial stack, as the fitter slides it on."""
+    length = part["z"][1] - part["z"][0]
+    if part["kind"] == "bearing":
+        return f"bearing {part['designation']} ({part['housing']}'s shoulder {part['stop']})"
+    if part["kind"] == "spacer":
+        return f"spacer {_number(length, 2)} mm"
+    if part["kind"] == "ring":
+        return part["designation"].replace("retaining ring ", "ring ")
+    return part["part"]
+
+
+def _retention_html(stacks: list, axial) -> str:
+    """What holds each part along its shaft (bottom up), and the check that nothing slides."""
+    if not stacks:
+        return ""
+    rows = [[_e(f"{r['shaft']}" + (f" (side {r['side']})" if r["side"] != 1 else "")),
+             _e(" | ".join(_stack_words(p) for p in r["stack"])),
+             _e("; ".join(f"{s['designation']} on {s['part']}" for s in r["set_screws"])
+                or "—")] for r in stacks]
+    verdict = ""
+    if axial:
+        free = axial.get("free") or []
+        verdict = ("<p>" + _pass_badge(axial.get("passed")) + " "
+                   + _e(f"{axial['parts']} parts along the axes, {axial['contacts']} contacts: "
+                        + ("every part is held both ways" if not free else
+                           "free to slide: " + ", ".join(
+                               f"{f['what']} ({' and '.join(f['ways'])})" for f in free)))
+                   + "</p>")
+    return ("<h3>What holds each part along its shaft</h3>"
+            "<p class=\"note\">Each shaft's parts from the bottom up: bearings against their "
+            "seats' shoulders, turned spacers between the parts, DIN 471 retaining rings in "
+            "grooves, a set screw onto the key where the shaft ends at a hub.</p>" + verdict
+            + _table(["shaft", "from the bottom up", "set screws"], rows))
 
 
 def _alignment_html(rows: list) -> str:

@@ -23,7 +23,7 @@ from cadgen.solids.parts import Part, planar_transform
 
 __all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "with_dowels", "dowel_positions",
            "housing_parts",
-           "printed_housing_parts", "shaft_part", "shaft_ends"]
+           "printed_housing_parts", "shaft_part", "shaft_ends", "spacer_parts"]
 
 #: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
 BOLT_BY_WALL = ((4.0, "M3"), (6.0, "M4"), (8.0, "M5"))
@@ -224,7 +224,8 @@ def _turn_of(transform) -> float:
     return math.atan2(transform[1, 0], transform[0, 0])
 
 
-def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=()) -> Part:
+def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=(),
+               retention=None) -> Part:
     """The shaft of a :class:`~cadgen.machine.model.Shaft` record as a part on ``body``.
 
     Named ``shaft-<axis>``, kind ``shaft``, built along z at the origin and placed at
@@ -242,6 +243,9 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=())
     ``hubs``: ``(name, z_bottom, z_top, key)`` of the other parts keyed to the shaft (the
     planter on E, the rocker on the planet shaft; z in the body frame), each with its
     placement and keyway in ``gears`` under ``name``: a keyseat centred on its hub.
+
+    ``retention`` (:class:`~cadgen.machine.retention.ShaftRetention`): a DIN 471 groove for
+    each of its retaining rings.
     """
     from cadgen.solids.split_housing import shaft_solid
 
@@ -282,6 +286,7 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=())
                          coupling.width, coupling.shaft_depth, 0.0))
     solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
                         flat_angle=flat_angle, segments=segments)
+    solid = _ring_grooves(solid, shaft, retention, housing.z_cavity_bottom, segments)
     if getattr(shaft, "bore", 0.0) > 0.0:
         solid = _hollow(solid, shaft, z_bottom, z_top, segments)
     offset = tuple(float(v) for v in shaft.xy)
@@ -326,3 +331,48 @@ def flange_bolt_holes(flange: dict, height: float, segments: int, diameter=None)
     cylinders = [m3d.Manifold.cylinder(height + 2.0, hole / 2, hole / 2, 24).translate(
         (x, y, -1.0)) for x, y in bolt_circle(flange)]
     return m3d.Manifold.batch_boolean(cylinders, m3d.OpType.Add)
+
+
+def _tube(inner: float, outer: float, z0: float, z1: float, segments: int):
+    """An annulus of radii ``inner < outer`` along z from ``z0`` to ``z1`` at the origin."""
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
+    height = z1 - z0
+    return (m3d.Manifold.cylinder(height, outer, outer, segments)
+            - m3d.Manifold.cylinder(height, inner, inner, segments)).translate((0.0, 0.0, z0))
+
+
+def _ring_grooves(solid, shaft, retention, z_floor: float, segments: int):
+    """The shaft with a DIN 471 groove (diameter d2, width m) for each ring of its stack (z
+    from its housing's cavity floor, at ``z_floor`` in the body)."""
+    if retention is None or not retention.rings:
+        return solid
+    from cadgen.machine.catalogue import shaft_ring
+
+    ring = shaft_ring(shaft.diameter)
+    cutter = None
+    for part in retention.rings:
+        # the groove's flank the ring bears on is flush with the part it holds, and the
+        # groove runs m (a little more than the ring's thickness) away from that part
+        z0 = z_floor + (part.z0 if _bears_below(retention, part) else part.z1 - ring["m"])
+        groove = _tube(ring["d2"] / 2, shaft.diameter, z0, z0 + ring["m"], segments)
+        cutter = groove if cutter is None else cutter + groove
+    return solid - cutter
+
+
+def _bears_below(retention, ring) -> bool:
+    """Whether ``ring`` holds a part just below it (else the part just above it)."""
+    return any(abs(p.z1 - ring.z0) < 1e-6 for p in retention.parts if p is not ring)
+
+
+def spacer_parts(shaft_part: Part, retention, z_floor: float, segments: int) -> list:
+    """The turned spacers of a shaft's stack as parts riding with the shaft (``shaft_part``'s
+    body and placement): tubes of the stack's bore and outside (z from the cavity floor, at
+    ``z_floor`` in the body)."""
+    if retention is None:
+        return []
+    return [Part(f"spacer-{retention.shaft}-{p.ref}", "spacer", shaft_part.body,
+                 _tube(p.bore / 2, p.outside / 2, z_floor + p.z0, z_floor + p.z1, segments),
+                 shaft_part.local)
+            for p in retention.spacers]

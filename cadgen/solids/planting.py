@@ -262,7 +262,8 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     """Both gearboxes as split housings (base and cover), and every shaft of the drivetrain."""
     from dataclasses import replace
 
-    from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
+    from cadgen.solids.machine_parts import (printed_housing_parts, shaft_part, spacer_parts,
+                                             stack_housing)
 
     a, r = mechanism.centre_distance, mechanism.r
     radius = {(c.gearbox, c.point): c.radius for c in circles}
@@ -304,14 +305,18 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     hub = drivetrain.fixings.get("planter")
     planter_hub = (("planter", layout.arm_bottom, layout.arm_bottom + hub["length"], hub["key"]),
                    ) if hub else ()
+    held = {(r.shaft, r.side): r for r in drivetrain.retention}
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
-            parts.append(shaft_part(shaft, housing2, "gearbox2", segments=segments,
-                                    gears=_frames_for(gears, "gearbox2"),
-                                    hubs=planter_hub if shaft.name == "E" else ()))
+            housing, body, hubs = housing2, "gearbox2", planter_hub if shaft.name == "E" else ()
         elif shaft.housing == "gearbox1" and shaft.side == 1:
-            parts.append(shaft_part(shaft, housing1, "carrier1", segments=segments,
-                                    gears=_frames_for(gears, "carrier1")))
+            housing, body, hubs = housing1, "carrier1", ()
+        else:
+            continue
+        stack = held.get((shaft.name, shaft.side))
+        part = shaft_part(shaft, housing, body, segments=segments,
+                          gears=_frames_for(gears, body), hubs=hubs, retention=stack)
+        parts += [part] + spacer_parts(part, stack, housing.z_cavity_bottom, segments)
     housings = (housing1, housing2)
     if "frame" in drivetrain.stacks:
         frame, frame_parts = _frame_parts(params, mechanism, drivetrain, layout, segments, gears)
@@ -328,7 +333,8 @@ def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
     from cadgen.solids.housings import ShellSize, flange_width
     from dataclasses import replace
 
-    from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
+    from cadgen.solids.machine_parts import (printed_housing_parts, shaft_part, spacer_parts,
+                                             stack_housing)
 
     drive = drivetrain.drive
     module = drive.module_1
@@ -355,8 +361,10 @@ def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
         if shaft.housing != "frame":
             continue
         body = "frame" if shaft.name == "input" else "carrier1"
-        parts.append(shaft_part(shaft, frame, body, segments=segments,
-                                gears=_frames_for(gears, body)))
+        stack = next((r for r in drivetrain.retention if r.shaft == shaft.name), None)
+        part = shaft_part(shaft, frame, body, segments=segments, gears=_frames_for(gears, body),
+                          retention=stack)
+        parts += [part] + spacer_parts(part, stack, frame.z_cavity_bottom, segments)
     return frame, parts
 
 

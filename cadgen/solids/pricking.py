@@ -76,7 +76,8 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     from dataclasses import replace
 
     from cadgen.solids.case_drive import case_drive_parts, sprocket_tapped_holes
-    from cadgen.solids.machine_parts import printed_housing_parts, shaft_part, stack_housing
+    from cadgen.solids.machine_parts import (printed_housing_parts, shaft_part, spacer_parts,
+                                             stack_housing)
 
     if drivetrain is None:
         from cadgen.machine.drivetrain import drivetrain as compute_drivetrain
@@ -184,11 +185,15 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
     rocker_z = height + roof + gap
     frames["rocker"] = (lambda angle: np.linalg.solve(body_pose("case", angle),
                                                       body_pose("planet", angle)), 0.0)
+    retention = {r.shaft: r for r in drivetrain.retention}
     shafts = [shaft_part(shaft, case, "case", segments=segments, gears=frames,
                          hubs=(("rocker", rocker_z, rocker_z + hub["length"], hub["key"]),)
-                         if hub and shaft.name == "planet" else ())
+                         if hub and shaft.name == "planet" else (),
+                         retention=retention.get(shaft.name))
               for shaft in drivetrain.shafts if shaft.housing == "gear-case"]
     parts += shafts
+    for part, shaft in zip(shafts, (s for s in drivetrain.shafts if s.housing == "gear-case")):
+        parts += spacer_parts(part, retention.get(shaft.name), case.z_cavity_bottom, segments)
     if held:
         sun = next(s for s in drivetrain.shafts if s.name == "sun")
         sun_part = next(p for p in shafts if p.name == "shaft-sun")
