@@ -240,8 +240,16 @@ def _retention_html(stacks: list, axial) -> str:
     """What holds each part along its shaft (bottom up), and the check that nothing slides."""
     if not stacks:
         return ""
+    def words(stack):   # a gap (a wall, another housing) between two runs of parts: "…"
+        out = []
+        for k, part in enumerate(stack):
+            if k and part["z"][0] - stack[k - 1]["z"][1] > 1.0:
+                out.append("…")
+            out.append(_stack_words(part))
+        return " | ".join(out)
+
     rows = [[_e(f"{r['shaft']}" + (f" (side {r['side']})" if r["side"] != 1 else "")),
-             _e(" | ".join(_stack_words(p) for p in r["stack"])),
+             _e(words(r["stack"])),
              _e("; ".join(f"{s['designation']} on {s['part']}" for s in r["set_screws"])
                 or "—")] for r in stacks]
     verdict = ""
@@ -256,7 +264,8 @@ def _retention_html(stacks: list, axial) -> str:
     return ("<h3>What holds each part along its shaft</h3>"
             "<p class=\"note\">Each shaft's parts from the bottom up: bearings against their "
             "seats' shoulders, turned spacers between the parts, DIN 471 retaining rings in "
-            "grooves, a set screw onto the key where the shaft ends at a hub.</p>" + verdict
+            "grooves, a set screw onto the key where the shaft ends at a hub; … where the "
+            "shaft passes a wall or another housing.</p>" + verdict
             + _table(["shaft", "from the bottom up", "set screws"], rows))
 
 
