@@ -46,7 +46,8 @@ def summary_text(report: dict) -> str:
     if "solids" in report:
         sections.append(format_solids(report["solids"]))
     if "machine" in report:
-        sections.append(format_machine(report["machine"], report.get("bom")))
+        sections.append(format_machine(report["machine"], report.get("bom"),
+                                       (report.get("assembly") or {}).get("axial")))
     sections.append(format_stages(report))
     return "\n\n".join(sections)
 
@@ -181,8 +182,9 @@ def format_cam(cam: dict) -> str:
     return "\n".join(lines)
 
 
-def format_machine(machine: dict, bom=None) -> str:
-    """Plain-text summary of the shafts, bearings, keys, rims and the bill of materials."""
+def format_machine(machine: dict, bom=None, axial=None) -> str:
+    """Plain-text summary of the shafts, bearings, keys, rims, what holds the parts along their
+    shafts (``axial``: report.json ``assembly.axial``) and the bill of materials."""
     shafts = machine.get("shafts", [])
     lines = [f"machine ({machine.get('process', MISSING)}): "
              + ", ".join(f"{s['name']} {_number(s['diameter_mm'], 'g')} mm"
@@ -198,6 +200,12 @@ def format_machine(machine: dict, bom=None) -> str:
         thin = min(rims, key=lambda r: r["rim_mm"] / r["module_mm"])
         lines.append(f"     thinnest rim under a bore: {_number(thin['rim_mm'], '.2f')} mm "
                      f"({thin['gear']}; fails below {_number(thin['limit_mm'], '.2f')} mm)")
+    if axial:
+        free = axial.get("free") or []
+        lines.append(f"     along the shafts: {axial['parts']} parts, held by shoulders, "
+                     "spacers, DIN 471 rings and set screws: "
+                     + ("every part held both ways" if not free else "FREE TO SLIDE: " + ", ".join(
+                         f"{f['what']} ({' and '.join(f['ways'])})" for f in free)))
     for problem in machine.get("problems", []):
         lines.append(f"     FAIL [{problem['code']}] {problem['message']}")
     if bom:
