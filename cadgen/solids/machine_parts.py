@@ -23,7 +23,7 @@ from cadgen.solids.parts import Part, planar_transform
 
 __all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "with_dowels", "dowel_positions",
            "housing_parts",
-           "printed_housing_parts", "shaft_part", "shaft_ends", "spacer_parts"]
+           "printed_housing_parts", "printer_cuts", "shaft_part", "shaft_ends", "spacer_parts"]
 
 #: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
 BOLT_BY_WALL = ((4.0, "M3"), (6.0, "M4"), (8.0, "M5"))
@@ -74,6 +74,9 @@ def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: floa
     Returns
     -------
     SplitHousing
+        With its dowels; printed, a :class:`~cadgen.solids.flange_chamfer.ChamferedHousing`
+        (45 deg gussets under the flange halves, clear of the splices of the segments it is
+        printed in, :func:`printer_cuts`).
     """
     from cadgen.solids.split_housing import split_housing
 
@@ -85,7 +88,13 @@ def stack_housing(params, circles, shell, stack, seats, *, z_cavity_bottom: floa
                             seats=seats, bolt_size=size,
                             bolt_hole_diameter=hole, segments=segments, path=path,
                             passages=passages, tapped=tapped)
-    return with_dowels(housing)
+    housing = with_dowels(housing)
+    if params.manufacturing.process != "printed":
+        return housing
+    from cadgen.solids.flange_chamfer import chamfer_flanges
+
+    return chamfer_flanges(housing, cuts=printer_cuts(housing, params,
+                                                      name=path.rsplit(".", 1)[-1]))
 
 
 def dowel_positions(housing) -> list:
@@ -152,7 +161,8 @@ def printed_housing_parts(name: str, housing, body: str, params) -> tuple:
     ``manufacturing.build_volume``; when one does not fit, the housing is cut across
     its long axis between its bearing seats (:mod:`cadgen.solids.segments`) and the
     parts are ``<name>-base-1``, ``<name>-base-2``, ..., ``<name>-cover-1``, ... (kind
-    ``housing`` on ``body``). Otherwise exactly :func:`housing_parts`.
+    ``housing`` on ``body``). Otherwise exactly :func:`housing_parts`. The cuts are the ones
+    its chamfers were made clear of (:func:`stack_housing`), else those of :func:`printer_cuts`.
 
     Returns
     -------
@@ -165,26 +175,16 @@ def printed_housing_parts(name: str, housing, body: str, params) -> tuple:
     DesignError
         At ``manufacturing.build_volume`` when no split between the seats fits.
     """
-    import numpy as np
-
-    from cadgen.solids.outcome import fits_build_volume, printing_pose
-
     parts = housing_parts(name, housing, body)
     if params.manufacturing.process != "printed":
         return parts, []
-    volume = tuple(float(v) for v in params.manufacturing.build_volume)
-    # the halves' meshes stay cached on their parts, so the check costs no second conversion
-    if all(fits_build_volume(np.ptp(part.mesh.copy().apply_transform(
-            printing_pose(part.mesh)).vertices, axis=0), volume) for part in parts):
+    chamfer = getattr(housing, "chamfer", None)   # its cuts chosen when it was chamfered
+    cuts = chamfer.cuts if chamfer is not None else printer_cuts(housing, params, name=name,
+                                                                 parts=parts)
+    if not cuts:
         return parts, []
-    from cadgen.solids.segments import (SEGMENT_MARGIN, segment_cuts, segment_housing,
-                                        segment_problems)
-    from kinematics.errors import DesignError
+    from cadgen.solids.segments import segment_housing
 
-    cuts = segment_cuts(housing, volume, margin=SEGMENT_MARGIN)
-    problems = segment_problems(housing, cuts, volume, margin=SEGMENT_MARGIN, name=name)
-    if problems:
-        raise DesignError(problems)
     split = segment_housing(housing, cuts, segments=housing.segments, name=name)
     parts = []
     for half in ("base", "cover"):
@@ -192,6 +192,36 @@ def printed_housing_parts(name: str, housing, body: str, params) -> tuple:
             stem = f"{name}-{half}-{piece.suffix}"
             parts.append(Part(stem, "housing", body, getattr(piece, half)))
     return parts, list(split.joints)
+
+
+def printer_cuts(housing, params, *, name: str = "housing", parts=None) -> list:
+    """The cut lines (:func:`cadgen.solids.segments.segment_cuts`) a printed housing is cut into
+    segments along, ``[]`` when each half fits ``manufacturing.build_volume`` whole in its
+    printing pose (:func:`cadgen.solids.outcome.printing_pose`). ``parts``: the housing's
+    :func:`housing_parts`, when made already (their meshes are cached on them).
+
+    Raises
+    ------
+    DesignError
+        At ``manufacturing.build_volume`` when no split between the seats fits.
+    """
+    import numpy as np
+
+    from cadgen.solids.outcome import fits_build_volume, printing_pose
+
+    volume = tuple(float(v) for v in params.manufacturing.build_volume)
+    parts = housing_parts(name, housing, "") if parts is None else parts
+    if all(fits_build_volume(np.ptp(part.mesh.copy().apply_transform(
+            printing_pose(part.mesh)).vertices, axis=0), volume) for part in parts):
+        return []
+    from cadgen.solids.segments import SEGMENT_MARGIN, segment_cuts, segment_problems
+    from kinematics.errors import DesignError
+
+    cuts = segment_cuts(housing, volume, margin=SEGMENT_MARGIN)
+    problems = segment_problems(housing, cuts, volume, margin=SEGMENT_MARGIN, name=name)
+    if problems:
+        raise DesignError(problems)
+    return cuts
 
 
 def shaft_ends(shaft, housing) -> tuple:
