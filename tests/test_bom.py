@@ -64,7 +64,11 @@ def test_two_bearings_per_shaft_and_their_bores_are_the_shafts(built):
             for h in s["hubs"] if h.get("runs_free_on")]
     assert len(free) == 2
     placed_free = sum(_instances(scene, gear) for gear in free)
-    assert sum(int(r["quantity"]) for r in bearings) == 2 * placed_shafts + 2 * placed_free
+    # and the duckbill's cam roller, a bearing on each lever's pin
+    rollers = _instances(scene, "lever")
+    assert rollers == 2
+    assert sum(int(r["quantity"]) for r in bearings) == (2 * placed_shafts + 2 * placed_free
+                                                         + rollers)
     diameters = {(s["name"], s["side"]): s["diameter_mm"] for s in machine["shafts"]}
     for bearing in machine["bearings"]:
         assert bearing["d_mm"] == diameters[bearing["shaft"], bearing["side"]]

@@ -255,13 +255,14 @@ def test_planting_names_positions_and_stack():
     top = train.bases["gearbox2"] + train.stacks["gearbox2"].cavity_height + \
         inner.seats[1].bearing.width
     assert inner.ends == pytest.approx((-inner.seats[0].bearing.width, top))
-    # E reaches through the cam (seated on the roof), the gap and the planter's keyed hub,
-    # and on past the hub for its DIN 471 ring: groove m = 1.1 and n = 1.1 beyond it (DIN 471
-    # for 15 mm), rounded up to 2.5 mm
+    # E reaches through the cam (seated on the roof), a gap, the duckbill lever's layer (the
+    # lever and a gap above it) and the planter's keyed hub, and on past the hub for its DIN 471
+    # ring: groove m = 1.1 and n = 1.1 beyond it (DIN 471 for 15 mm), rounded up to 2.5 mm
     hub = train.fixings["planter"]
     assert hub["length"] >= params.planter.arm_thickness
     assert shaft.extends_above == pytest.approx(params.cam.thickness + params.housing.axial_gap
-                                                + hub["length"] + 2.5)
+                                                + params.cam.lever.thickness
+                                                + params.housing.axial_gap + hub["length"] + 2.5)
 
 
 def test_planting_speeds_follow_the_train():

@@ -26,8 +26,9 @@ from typing import Callable, Iterable, Union
 FIXED = "fixed"
 #: Lower pairs: each leaves one planar freedom between its parts, so removes two.
 LOWER_PAIRS = ("revolute", "prismatic")
-#: Higher pairs (point or line contact): each removes one planar freedom.
-HIGHER_PAIRS = ("gear", "cam")
+#: Higher pairs (point or line contact): each removes one planar freedom. A pin in a slot
+#: (``slot``) turns and slides: two freedoms left, one removed, as a cam contact.
+HIGHER_PAIRS = ("gear", "cam", "slot")
 JOINT_KINDS = (FIXED,) + LOWER_PAIRS + HIGHER_PAIRS
 MOBILITY_FORMULA = "M = 3 (N - 1) - 2 J1 - J2"
 

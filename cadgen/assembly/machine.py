@@ -19,9 +19,12 @@ coaxial: in the plane it adds nothing, so it is named in the joint's detail, not
 twice, and its bearings are bought with that joint); a keyed gear is fixed to its shaft, a
 gear running free on its bearings is a revolute joint to it; a hollow shaft's flange is fixed
 to the housing it carries. A joint the workshop does not yet get as parts (the planter's
-fixing on shaft E, the cam's screws, the blades' hinge pins and the duckbill linkage between
-cam and blades) is in the graph for its kinematics and listed in :data:`NOT_MADE` so the
-report claims nothing it does not make.
+fixing on shaft E without a hub, the cam's screws without their fixing) is in the graph for its
+kinematics and listed in :data:`NOT_MADE` so the report claims nothing it does not make. The
+duckbill linkage (lever, roller, push rod, links, blades on their pins, the return spring) is
+in the graph as parts when the drivetrain sized it (``fixings["duckbill"]``, with the cam) and
+the solids made it; without it the blades hang on the planter and on the cam directly, marked
+not made.
 """
 
 from __future__ import annotations
@@ -283,12 +286,64 @@ def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None,
         planter = b.instance("planter-shell", copy)
         b.joint("fixed", planter, f"shaft-E-{copy}", *_hub_joint(fixings.get("planter"),
                                                                  "on shaft E"))
+        linkage = fixings.get("duckbill")
+        if linkage is not None and (bodies is None or "lever" in bodies):
+            _duckbill_joints(b, linkage, copy, planter, cam)
+            continue
         for blade in ("blade-right", "blade-left"):
             me = b.instance(blade, copy)
             b.joint("revolute", me, planter, "hinge: " + NOT_MADE[0] + " (pin)")
             b.joint("cam", me, f"cam-{copy}",
                     "opened by the cam through the duckbill linkage: " + NOT_MADE[0])
     return b.model(frame)
+
+
+def _duckbill_joints(b, linkage: dict, copy: str, planter: str, cam: str) -> None:
+    """One arm's duckbill linkage (:mod:`cadgen.machine.duckbill`): the lever on the planter at
+    H, its roller on the cam, the pin G in the push rod's slot, the rod sliding in the tube's
+    web against its spring, the links from the rod's end P2 to the blades' cranks J, the blades
+    on their hinges O1.
+
+    The roller is the bought bearing on the lever's pin, so the lever-cam contact carries it:
+    as a shaft's bearings are items of its revolute, the roller's spin is the bearing's own
+    and not a body of the graph (a roller body would add Norton's idle freedom to the count).
+    Every body added is held by exactly the joints it needs: the mobility stays the drive's.
+    """
+    pins = linkage.get("pins", {})
+
+    def items(entries) -> tuple:
+        return tuple(Item(e["kind"], e["description"], e["designation"], int(e["count"]))
+                     for e in entries)
+
+    def pin(joint: str) -> tuple:
+        entry = pins.get(joint)
+        return ((entry["designation"], items(entry["items"])) if entry
+                else (NOT_MADE[0] + " (pin)", ()))
+
+    lever, rod = b.instance("lever", copy), b.instance("push-rod", copy)
+    name, bought = pin("H")
+    b.joint("revolute", lever, planter, f"lever on {name} at H, in the plate's lug", bought)
+    roller = linkage.get("roller") or {}
+    b.joint("cam", lever, cam, f"roller {roller.get('designation', '')} at I on the cam "
+            f"(its pin {roller.get('pin', '')} pressed into the lever, {roller.get('ring', '')} "
+            "under it)", items(roller.get("items", ())))
+    name, bought = pin("G")
+    b.joint("slot", lever, rod, f"{name} at G through the lever, in the push rod's slot", bought)
+    spring = linkage.get("spring") or {}
+    b.joint("prismatic", rod, planter,
+            "guided in the tube's web; the return spring between the web and the rod's collar"
+            + (f" ({spring['designation']})" if spring else ""),
+            items(linkage.get("spring_items", ())))
+    for side in ("right", "left"):
+        link, blade = b.instance(f"blade-link-{side}", copy), b.instance(f"blade-{side}", copy)
+        name, bought = pin("O1")
+        b.joint("revolute", blade, planter, f"hinge O1: {name} through the tube's ears", bought)
+        name, bought = pin("J")
+        b.joint("revolute", link, blade, f"crank pin J: {name}", bought)
+        name, bought = pin("P2")
+        # one pin at P2 through both links and the rod's eye: bought with the right link's joint
+        b.joint("revolute", link, rod, f"P2: {name} through both links and the rod's eye",
+                bought if side == "right" else ())
 
 
 def pricking_model(drivetrain, meshes=(), *, bodies=None, housings=None,

@@ -1,8 +1,8 @@
 """The order a fitter puts the machine together in, read from the assembly model's joints.
 
-Every holding joint (fixed or revolute) is one step: which part goes onto which, what makes the
-joint and what it is bought with, with the tightening torque of its screws. The steps come in
-the order a workshop works:
+Every holding joint (fixed, revolute, prismatic, or a pin in a slot) is one step: which part goes
+onto which, what makes the joint and what it is bought with, with the tightening torque of its
+screws. The steps come in the order a workshop works:
 
 1. sub-assemblies: each gear keyed to, or run on its bearings on, its shaft;
 2. the housings outward from the frame (a breadth-first walk of the holding joints from the
@@ -10,9 +10,12 @@ the order a workshop works:
    hollow shafts' flanges bolted to the housing they carry, then the cover closed on its dowels
    and bolts; the splices of a housing cut into segments before that;
 3. what rides on the outside: the cam, the planter, the needle, the sprocket, in the same walk;
-4. a frame that is no housing (the pricking machine's bracket) takes the machine last.
+4. a frame that is no housing (the pricking machine's bracket) takes the machine last;
+5. a contact that is bought with something (the duckbill lever's roller, which meets the cam)
+   is a step just before its part goes in: the roller is fitted to the lever first.
 
-Meshes and cam contacts are no steps (they follow from the placing). Standard library only.
+Other meshes and cam contacts are no steps (they follow from the placing). Standard library
+only.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from __future__ import annotations
 import re
 from collections import deque
 
-__all__ = ["assembly_sequence", "TIGHTENING_TORQUE_NM"]
+__all__ = ["assembly_sequence", "TIGHTENING_TORQUE_NM", "HOLDING"]
 
 #: A housing's base (or one of its segments), on a side or an arm.
 _BASE = re.compile(r"-base(-\d+)?(-(arm|side)\d)?$")
@@ -29,6 +32,8 @@ _BASE = re.compile(r"-base(-\d+)?(-(arm|side)\d)?$")
 #: coefficient of 0.14 in thread and head (the usual table from VDI 2230, 90 % of the yield
 #: point); into a tapped aluminium housing take no more than 80 % of it.
 TIGHTENING_TORQUE_NM = {"M3": 1.3, "M4": 3.0, "M5": 5.9, "M6": 10.1, "M8": 24.6}
+#: Joint kinds that hold a part in place: one step each.
+HOLDING = ("fixed", "revolute", "prismatic", "slot")
 
 
 def _torque(item) -> str:
@@ -54,7 +59,7 @@ def _is_gear_on_shaft(joint, kinds: dict) -> bool:
 def assembly_sequence(model) -> list[dict]:
     """The numbered steps (``step``, ``part``, ``onto``, ``joint``, ``how``, ``bought``) that put
     ``model``'s machine together (see the module notes); every holding joint once."""
-    holding = [j for j in model.joints if j.kind in ("fixed", "revolute")]
+    holding = [j for j in model.joints if j.kind in HOLDING]
     kinds = {p.instance: p.kind for p in model.placements}
     done, steps = set(), []
 
@@ -118,4 +123,15 @@ def assembly_sequence(model) -> list[dict]:
         for joint in neighbours.get(model.frame, []):
             done.discard(id(joint))
             add(joint, joint.b if joint.a == model.frame else joint.a, model.frame)
+    # 5. a contact bought with something (the duckbill lever's roller, on its pin pressed into
+    # the lever): fitted to its part just before that part goes in (the planter's plate covers
+    # the pin's end once the lever is on its pivot)
+    for joint in model.joints:
+        if joint.kind not in HOLDING and joint.items:
+            add(joint, joint.a, joint.b)
+            step = steps.pop()
+            at = next((k for k, s in enumerate(steps) if s["part"] == joint.a), len(steps))
+            steps.insert(at, step)
+    for number, step in enumerate(steps, start=1):
+        step["step"] = number
     return steps

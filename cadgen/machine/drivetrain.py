@@ -478,6 +478,12 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
     problems += _cam_bore_problems(params, shafts)
     shafts, fixings, found = arm_fixings(params, shafts, stacks, fits, cam)
     problems += found
+    if params.mechanism == "planting" and cam is not None:   # the duckbill linkage's parts,
+        from cadgen.machine.duckbill import duckbill_fixing   # pins, roller and spring
+
+        duckbill, found = duckbill_fixing(params, design, cam, fits)
+        problems += found
+        fixings.update({"duckbill": duckbill} if duckbill is not None else {})
     held = None
     if params.mechanism == "pricking":
         held, found = _pricking_case_drive(params, design, shafts, loads)

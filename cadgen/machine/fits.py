@@ -123,7 +123,8 @@ class Material(NamedTuple):
 
 
 #: The part kinds a material is given for.
-PART_KINDS = ("gear", "cam", "planter", "housing", "shaft", "blade", "rocker", "needle", "spacer")
+PART_KINDS = ("gear", "cam", "planter", "housing", "shaft", "blade", "rocker", "needle", "lever",
+              "link", "push-rod", "spacer")
 
 # Densities: steel 7850 kg/m^3 (EN 10025 / EN 10083 data sheets), aluminium EN AW-6082 2700,
 # PETG 1270 (filament makers' data sheets).
@@ -135,13 +136,17 @@ _PETG = ("PETG", 1270.0)
 
 
 def _materials(gear, cam, planter, housing, blade, rocker, needle) -> dict:
-    # shafts are turned steel whatever the process: a printed shaft would not carry a key's torque
+    # shafts are turned steel whatever the process: a printed shaft would not carry a key's torque;
+    # the duckbill's push rod likewise (it slides in its guide and carries the long pin G)
     return {"gear": Material(*gear), "cam": Material(*cam), "planter": Material(*planter),
             "housing": Material(*housing), "shaft": Material(*_STEEL_C45, "turned"),
             "blade": Material(*blade), "rocker": Material(*rocker), "needle": Material(*needle),
             # the spacers too: turned from tube or bar in any process, they carry the stack's
             # axial load and keep their length
-            "spacer": Material(*_STEEL_S235, "turned")}
+            "spacer": Material(*_STEEL_S235, "turned"),
+            # the duckbill's lever and links are plates cut as the rocker is
+            "lever": Material(*rocker), "link": Material(*rocker),
+            "push-rod": Material(*_STEEL_C45, "turned")}
 
 
 @dataclass(frozen=True)

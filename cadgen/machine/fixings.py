@@ -286,6 +286,8 @@ def fixings_report(fixings: dict) -> dict:
     """The fixings as plain JSON (a key as its designation, sizes and pressure)."""
     out = {}
     for name, fixing in fixings.items():
+        if name == "duckbill":   # a section of its own (cadgen.machine.duckbill.duckbill_report)
+            continue
         entry = {k: v for k, v in fixing.items() if k != "key"}
         key = fixing.get("key")
         if "key" in fixing:

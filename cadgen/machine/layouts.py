@@ -137,13 +137,16 @@ def planting_axes(params, mechanism, drive=None) -> tuple:
     bases = planting_bases(cavities, gap)
     loads = planting_loads(mechanism, params.machine, gears.pressure_angle_rad,
                            params.field.carrier_speed_rpm, drive=drive)
-    cam, arm = params.cam.thickness, params.planter.arm_thickness
+    # the cam plate and, a gap above it, the duckbill's lever (its layer below the planter)
+    cam = params.cam.thickness + params.cam.lever_layer(gap)
+    arm = params.planter.arm_thickness
     a, r = float(mechanism.centre_distance), float(mechanism.r)
     line = (math.cos(mechanism.phi0), math.sin(mechanism.phi0))
     radii = mechanism.carrier_radii
 
     def planter_plane(walls, base):   # the planter plate's mid-plane above gearbox 2's roof
-        # (the cam is seated on the roof, the planter turns a gap above it)
+        # (the cam is seated on the roof, the lever turns a gap above it, the planter a gap
+        # above the lever)
         return (base["gearbox2"] + box2 + walls["gearbox2"][1]) + cam + gap + arm / 2
 
     stub = lambda d: STUB_DIAMETERS * d + STUB_EXTRA   # noqa: E731

@@ -36,6 +36,9 @@ class LeverParameters(_Table):
     roller_arm: float = Field(45.0, gt=0, description="lever pivot H to the roller centre I, mm")
     rod_arm: float | None = Field(None, gt=0, description="lever pivot H to the push-rod pin G, mm "
                                                           "(default: to the duckbill axis, L1 - base radius)")
+    thickness: float = Field(5.0, gt=0, le=50, description="lever plate thickness, mm (the lever "
+                                                          "turns in a layer of its own between the "
+                                                          "cam and the planter's plate)")
 
 
 class CamTimingParameters(_Table):
@@ -79,3 +82,8 @@ class CamParameters(_Table):
     @property
     def closed_half_angle_rad(self) -> float:
         return math.radians(self.duckbill.closed_half_angle_deg)
+
+    def lever_layer(self, gap: float) -> float:
+        """How much higher the planter's plate stands for the lever (mm): the lever turns
+        ``gap`` above the cam, and the plate ``gap`` above the lever."""
+        return self.lever.thickness + gap

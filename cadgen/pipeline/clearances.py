@@ -19,6 +19,10 @@ angle (see that module for the formula ``v + w * reach + u``):
   is smooth: cycloidal or 3-4-5), times its reach from the hinge, with the
   Coriolis term ``2 w beta'``; its reach from E is at most the hinge's distance
   from E plus that reach, however far it opens;
+* the duckbill linkage's lever, push rod and links move in the planter by the cam law: each
+  gets the planter's bounds at its reach from E plus its own motion there (the lever's turn
+  about H, the rod's slide, a link's crank pin and turn), sampled like the blades', with the
+  Coriolis term;
 * gearbox 1 (base and cover) turns about O at rate 1; the ground and the frame are fixed;
   the pricking gear case and the sprocket under it turn about O at rate 1.
 
@@ -50,6 +54,8 @@ _ENCLOSED_KINDS = frozenset({"gear", "spacer"})
 _GEARBOX2_FIXED = ("gearbox2-base", "gearbox2-cover", "cam")
 #: Gearbox 2's shafts, turning on their axes with their gears.
 _GEARBOX2_SHAFTS = ("shaft-D", "shaft-E")
+#: The duckbill linkage's parts (lever, push rod, links): they move in the planter by the cam law.
+_LINKAGE_KINDS = frozenset({"lever", "push-rod", "link"})
 #: A housing half cut into segments to fit a printer: ``<half>-1``, ``<half>-2``, ...
 _SEGMENT = re.compile(r"-\d+$")
 
@@ -167,7 +173,57 @@ def _arm_part_bounds(mechanism, parts, cam) -> dict:
             bounds[name] = (mechanism.speed_bound("E") + spin * reach_e + rate * reach_h,
                             mechanism.acceleration_bound("E") + turn * reach_e
                             + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
+    for name, part in parts.items():
+        if part.kind in _LINKAGE_KINDS and cam is not None:
+            speed, acceleration, reach_e = _linkage_motion(cam, part)
+            bounds[name] = (mechanism.speed_bound("E") + spin * reach_e + speed,
+                            mechanism.acceleration_bound("E") + turn * reach_e + acceleration
+                            + 2 * spin * speed)
     return bounds
+
+
+def _linkage_motion(cam, part, samples: int = 20_000):
+    """A duckbill linkage part's motion in the planter: the largest speed and acceleration (per
+    carrier radian, sampled, +25 %) of any of its points there, and its largest reach from E."""
+    from cadgen.sweep.scene import part_reach
+
+    phi = np.linspace(0.0, 2 * np.pi, samples + 1)
+    step = phi[1] - phi[0]
+    linkage = cam.linkage
+    lam = cam.profile.program(cam.cam_angle(phi))[0]
+
+    def rates(values):
+        rate = np.gradient(values, step, axis=0)
+        return rate, np.gradient(rate, step, axis=0)
+
+    if part.kind == "lever":   # turns about H
+        pivot = linkage.lever_pivot
+        reach = part_reach(part, body_origin_local=(*pivot, 0.0), axis=_Z)
+        rate, rate_rate = rates(lam)
+        speed = np.abs(rate) * reach
+        acceleration = (np.abs(rate_rate) + rate**2) * reach
+        reach_e = float(np.hypot(*pivot)) + reach
+    elif part.kind == "push-rod":   # slides along the duckbill axis
+        travel = linkage.rod_arm * np.sin(lam)
+        rate, rate_rate = rates(travel)
+        speed, acceleration = np.abs(rate), np.abs(rate_rate)
+        reach_e = part_reach(part, axis=_Z) + float(np.max(np.abs(travel)))
+    else:   # a link, from its blade's crank pin J to the rod's end P2 (its frame's origin at J)
+        beta = linkage.opening_of_lever(lam)
+        pin = linkage.crank_pin(beta)
+        if part.name.endswith("left"):
+            pin = np.stack([-2.0 * linkage.L1 - pin[:, 0], pin[:, 1]], axis=-1)
+        end_y = linkage.push_rod_end(beta)
+        angle = np.unwrap(np.arctan2(end_y - pin[:, 1], -linkage.L1 - pin[:, 0]))
+        reach = float(np.max(np.linalg.norm(part.mesh.vertices[:, :2], axis=1)))
+        pin_rate, pin_rate_rate = rates(pin)
+        rate, rate_rate = rates(angle)
+        speed = np.linalg.norm(pin_rate, axis=1) + np.abs(rate) * reach
+        acceleration = (np.linalg.norm(pin_rate_rate, axis=1)
+                        + (np.abs(rate_rate) + rate**2) * reach)
+        reach_e = float(np.max(np.linalg.norm(pin, axis=1))) + reach
+    return (SAMPLED_MARGIN * float(np.max(speed)), SAMPLED_MARGIN * float(np.max(acceleration)),
+            reach_e)
 
 
 def _hinge(linkage, blade: str) -> np.ndarray:

@@ -216,9 +216,10 @@ PART_OUTLINE_TOLERANCE = 0.1
 
 def _outline_of(part):
     """A part's outline in the plane, in its own frame: a gear's or the cam's cut outline, a
-    housing half's flange outline; None for the parts drawn by the kinematics (the planter,
-    the blades, the rocker, the needle) or seen only edge-on (a shaft). A housing's cover has
-    its base's outline: only the base is drawn."""
+    housing half's flange outline, the duckbill lever's and links' plates, the push rod's
+    silhouette; None for the parts drawn by the kinematics (the planter, the blades, the
+    rocker, the needle) or seen only edge-on (a shaft). A housing's cover has its base's
+    outline: only the base is drawn."""
     if part.kind == "housing" and "-cover" in part.name:
         return None
     shape = part.outline if part.outline is not None else part.footprint
@@ -236,7 +237,8 @@ def parts_layer(assembly, turns) -> dict | None:
     pose]}}`` (SVG frame: y down, so a turn is clockwise), or None when no part has an outline.
 
     Every instance the assembly model places is drawn where the solids are: the housings
-    (the frame's among them), the gears of both trains and the drive, the cam.
+    (the frame's among them), the gears of both trains and the drive, the cam, the duckbill
+    linkage's lever, push rod and links (moving by the cam law, as in the assembly).
     """
     turns = [float(t) for t in turns]
     assembly.prepare(turns)
@@ -281,7 +283,8 @@ def with_parts(data: dict, assembly) -> dict:
     corners = np.array([[view[0], -view[1]], [view[0] + view[2], -(view[1] + view[3])]])
     data = dict(data, parts=layer, view=_bounds(corners, _layer_points(layer)))
     data["legend"] = data["legend"] + [("part gear", "the machine's parts as the assembly "
-                                                    "model places them (housings, gears, cam)")]
+                                                    "model places them (housings, gears, cam, "
+                                                    "the duckbill's lever, push rod and links)")]
     return data
 
 

@@ -57,7 +57,10 @@ def _made_rows(solids_report: dict, fits) -> list:
 _DESCRIPTIONS = {"gear": "gear", "housing": "gearbox housing half", "cam": "cam plate",
                  "planter": "planter (arm plate and duckbill tube)", "blade": "duckbill blade",
                  "rocker": "rocker", "needle": "needle", "shaft": "shaft",
-                 "spacer": "spacer (turned sleeve between the parts on a shaft)"}
+                 "spacer": "spacer (turned sleeve between the parts on a shaft)",
+                 "lever": "duckbill cam lever (bell crank H-I-G, the roller's pin pressed in)",
+                 "push-rod": "duckbill push rod (collar with the G slot, eye at P2)",
+                 "link": "duckbill blade link (J to P2)"}
 
 
 #: The bought rows' order: bearings, then keys, then the rest (screws, nuts, washers, the

@@ -160,6 +160,11 @@ def assemble_report(run, set_aside: dict) -> dict:
     if "drivetrain" in ok:
         report["machine"] = machine_section(params, values["drivetrain"],
                                             values["teeth"] if "teeth" in ok else None)
+        duckbill = values["drivetrain"].fixings.get("duckbill")
+        if duckbill is not None:   # the linkage's spring, roller, pins and loads
+            from cadgen.machine.duckbill import duckbill_report
+
+            report["duckbill"] = duckbill_report(duckbill)
         # the assembly model: the solids' (placed, with the bought items of their joints)
         # when they were built, else the joint graph from the drivetrain records alone
         from cadgen.assembly.machine import model_report

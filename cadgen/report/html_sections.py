@@ -292,6 +292,18 @@ def _cam_section(report: dict) -> str:
     verdict = "the roller can follow the contour" if state == "pass" else "cam problems below"
     body = (f"<p>{_badge(state)} {verdict}</p>"
             + _key_values(shown) + _problem_list(cam.get("problems", [])))
+    duckbill = report.get("duckbill")
+    if duckbill:   # the linkage's return spring, roller and pins (cadgen.machine.duckbill)
+        spring = duckbill.get("spring") or {}
+        keys = ("designation", "wire", "mean_diameter", "active_coils", "free_length",
+                "installed_length", "working_length", "solid_length", "rate", "preload",
+                "force_max", "stress_max", "stress_allowed", "utilisation")
+        body += ("<h3>Duckbill linkage</h3>"
+                 + _key_values({"return spring": {k: spring[k] for k in keys if k in spring},
+                                "roller": duckbill["roller"],
+                                "loads": duckbill["follower"],
+                                "pins": {joint: pin["designation"]
+                                         for joint, pin in duckbill["pins"].items()}}))
     return _section("cam", "Duckbill cam", body)
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 __all__ = ["summary_text", "format_metrics_table", "format_gear_table", "format_cam",
+           "format_duckbill",
            "format_solids", "format_machine", "format_clearances", "format_stages", "format_verdict"]
 
 #: Printed for a number the report does not have.
@@ -42,7 +43,8 @@ def summary_text(report: dict) -> str:
     if "gear_train" in report:
         sections.append(format_gear_table(report["gear_train"], report))
     if "cam" in report:
-        sections.append(format_cam(report["cam"]))
+        sections.append(format_cam(report["cam"]) + (
+            "\n" + format_duckbill(report["duckbill"]) if "duckbill" in report else ""))
     if "solids" in report:
         sections.append(format_solids(report["solids"]))
     if "machine" in report:
@@ -179,6 +181,27 @@ def format_cam(cam: dict) -> str:
         lines.append(f"     FAIL [{problem['code']}] {problem['message']}")
     if cam.get("not_written"):
         lines.append(f"     {cam['not_written']}")
+    return "\n".join(lines)
+
+
+def format_duckbill(duckbill: dict) -> str:
+    """Plain-text lines of the duckbill linkage: its return spring and the roller's force."""
+    spring, roller, follower = duckbill.get("spring"), duckbill["roller"], duckbill["follower"]
+    lines = []
+    if spring:
+        lines.append(
+            f"     return spring: wire {_number(spring['wire'], 'g')} mm (EN 10270-1 DH), D "
+            f"{_number(spring['mean_diameter'], '.1f')} mm, n {_number(spring['active_coils'], 'g')}"
+            f", L0 {_number(spring['free_length'], '.1f')} mm, {_number(spring['rate'], '.2f')} N/mm;"
+            f" {_number(spring['preload'], '.1f')} N closed (contact needs "
+            f"{_number(follower['needed_spring_force_max_n'], '.1f')} N x "
+            f"{_number(follower['safety_factor'], 'g')}), {_number(spring['force_max'], '.1f')} N "
+            f"open; stress {_number(spring['stress_max'], '.0f')} of "
+            f"{_number(spring['stress_allowed'], '.0f')} MPa")
+    lines.append(f"     roller {roller['bearing']}: contact force "
+                 f"{_number(roller['contact_force_min_n'], '.1f')}.."
+                 f"{_number(roller['contact_force_max_n'], '.1f')} N at "
+                 f"{_number(follower['carrier_speed_rpm'], 'g')} r/min")
     return "\n".join(lines)
 
 

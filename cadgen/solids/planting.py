@@ -14,15 +14,16 @@ the arms. Bodies and their poses at carrier angle ``phi`` (arm 2 is arm 1 at
     Origin at C, x along C->D->E (``gamma = phic + phi``): the housing, the four
     gears of the second train, and the cam (fixed to gearbox 2, coaxial with E).
 ``planter``
-    Origin at E, x along ``u(Psi)``: the arm plate E-P1, the duckbill tube and the
-    two blades (opened by the cam's law at the pose).
+    Origin at E, x along ``u(Psi)``: the arm plate E-P1, the duckbill tube, the
+    two blades and the linkage that opens them (lever, push rod, links), each moved by
+    the cam's law at the pose.
 ``ground``
     Fixed: the soil (flat or a ridge along the travel), its top at the soil level.
 
 Axial stack (z, from the machine outwards): gearbox 1 (train 1's gears), gearbox
-2 (layer 1: the non-circular pair; layer 2: the 1:1 circular pair), the cam plate,
-the planter's arm plate, and the duckbill tube beside it. Every gap between them
-is ``housing.axial_gap``; the housings' end walls, cavity heights, gear layers and
+2 (layer 1: the non-circular pair; layer 2: the 1:1 circular pair), the cam plate
+(the duckbill's roller in it), the duckbill lever's layer, the planter's arm plate,
+and the duckbill tube beside it. Every gap between them is ``housing.axial_gap``; the housings' end walls, cavity heights, gear layers and
 parting planes are the drivetrain's (:class:`~cadgen.machine.model.HousingStack`,
 end walls thick enough for the bearing seats). The housings' outlines are the
 hull of the same envelope discs the kinematic clearance checks use (largest tip +
@@ -35,9 +36,11 @@ each shaft is a part of its housing's body (:mod:`cadgen.solids.machine_parts`).
 Each part is built once, in its body's frame; which copies exist (per arm, per
 side of carrier 1) and where they ride is the assembly model's to say
 (:mod:`cadgen.assembly.machine`, :func:`~cadgen.solids.parts.placed_assembly`).
-Not made as solids: the cam lever, push rod and blade links (their motion is in the
-cam report), and the bought items (bearings, keys, screws: on the model's joints,
-in the bill).
+The duckbill linkage (lever, push rod, links, the blades' knuckles and cranks, the
+shell's lug, web and hinge ears) is :mod:`cadgen.solids.duckbill`'s, cut to the sizes
+the drivetrain gave it (``fixings["duckbill"]``). Not made as solids: the bought items
+(bearings, the cam roller, keys, screws, pins, the return spring: on the model's
+joints, in the bill).
 """
 
 from __future__ import annotations
@@ -58,7 +61,8 @@ __all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius", "GEARLESS_K
 #: drivetrain's stacks, not from the gears' outlines. Not the gears, not the shafts (each
 #: keyseat turns to its gear's keyway). A build sweeps the gearless assembly beside the teeth
 #: and takes these parts' meshes from it (:mod:`cadgen.pipeline.beside`).
-GEARLESS_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground"})
+GEARLESS_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground", "lever", "push-rod",
+                            "link"})
 
 
 @dataclass(frozen=True)
@@ -88,6 +92,7 @@ class PlantingLayout:
     box2_layers: tuple
     frame_floor: float = 0.0        # the frame's (transmission box's) cavity floor
     frame_layers: tuple = ()        # its two gear layers' bottoms (the drive's pairs)
+    lever_bottom: float | None = None   # the duckbill lever's lower face (None: no cam, no lever)
 
     @property
     def layer0(self) -> float:
@@ -129,7 +134,9 @@ def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayo
     box2_floor = drivetrain.bases.get("gearbox2", box1_height + walls[1] + gap + walls[2])
     cam_bottom = box2_floor + box2_height + walls[3]
     cam_thickness = params.cam.thickness if cam_design is not None else 0.0
-    arm_bottom = cam_bottom + cam_thickness + gap
+    # the duckbill's lever turns a gap above the cam, the planter's plate a gap above the lever
+    lever = params.cam.lever_layer(gap) if cam_design is not None else 0.0
+    arm_bottom = cam_bottom + cam_thickness + gap + lever
     arm_thickness = params.planter.arm_thickness
     tube_radius = _tube_radius(params, cam_design)
     # the tube stands beside the arm plate, overlapping it by one shell wall so they join
@@ -141,7 +148,8 @@ def layout_of(params, mechanism, shells, cam_design, drivetrain) -> PlantingLayo
     frame_layers = tuple(frame_floor + z for z, _ in frame.layers) if frame is not None else ()
     return PlantingLayout(face_nc, face_c, gap, 0.0, box1_height, w1, box2_floor, box2_height, w2,
                           cam_bottom, cam_thickness, arm_bottom, arm_thickness, tube_axis,
-                          tube_radius, *walls, layers1, layers2, frame_floor, frame_layers)
+                          tube_radius, *walls, layers1, layers2, frame_floor, frame_layers,
+                          cam_bottom + cam_thickness + gap if cam_design is not None else None)
 
 
 def _tube_radius(params, cam_design) -> float:
@@ -400,8 +408,11 @@ def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
     return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour)
 
 
-def _planter_parts(params, cam_design, layout, segments, hub=None):
-    """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades.
+def _planter_parts(params, cam_design, layout, segments, hub=None, duckbill=None):
+    """The planter shell (arm plate E-P1 and the duckbill tube) and the two blades; with the
+    linkage's sizes (``duckbill``, the drivetrain's ``fixings["duckbill"]``) and the cam, the
+    lever, push rod and links too, and the lugs, web and hinges they need on the shell and the
+    blades (:mod:`cadgen.solids.duckbill`).
 
     ``hub`` (:func:`cadgen.machine.fixings.keyed_hub`, the drivetrain's ``fixings["planter"]``):
     the plate's boss at E, up from the plate, and its bore with the keyway (towards the
@@ -460,9 +471,17 @@ def _planter_parts(params, cam_design, layout, segments, hub=None):
 
     hinge_right = np.array([-L1 + e, hinge_y])
     hinge_left = np.array([-L1 - e, hinge_y])
+    linkage = []
+    if duckbill is not None and cam_design is not None and layout.lever_bottom is not None:
+        from cadgen.solids.duckbill import blade_features, linkage_parts, shell_features
+
+        shell = shell_features(shell, duckbill, layout, segments)
+        right = blade_features(right, "right", duckbill, layout, segments)
+        left = blade_features(left, "left", duckbill, layout, segments)
+        linkage = linkage_parts(duckbill, layout, cam_design, segments)
     return [Part("planter-shell", "planter", "planter", shell),
             Part("blade-right", "blade", "planter", right, blade_local(1.0, hinge_right)),
-            Part("blade-left", "blade", "planter", left, blade_local(-1.0, hinge_left))]
+            Part("blade-left", "blade", "planter", left, blade_local(-1.0, hinge_left))] + linkage
 
 
 def _stand_up(solid):
@@ -527,7 +546,7 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
     if cam_design is not None and cam_design.cuttable:
         parts.append(_cam_part(params, mechanism, cam_design, layout, segments, drivetrain))
     parts += _planter_parts(params, cam_design, layout, segments,
-                            drivetrain.fixings.get("planter"))
+                            drivetrain.fixings.get("planter"), drivetrain.fixings.get("duckbill"))
     x_range = mechanism_extent(mechanism, circles)
     z_range = layout.z_range
     if soil_level is not None:

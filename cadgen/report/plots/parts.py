@@ -16,7 +16,8 @@ __all__ = ["assembly_view", "pair_figure_jobs", "pair_figures", "pair_figure_dat
 
 
 _COLOURS = {"ground": "#b5895a", "housing": "#8fa3b8", "gear": "#d9a441", "cam": "#7a9e7e",
-            "planter": "#6d7f99", "blade": "#4f5d73", "rocker": "#6d7f99", "needle": "#3b4657"}
+            "planter": "#6d7f99", "blade": "#4f5d73", "rocker": "#6d7f99", "needle": "#3b4657",
+            "lever": "#2f6fa8", "push-rod": "#6e747c", "link": "#4d7fb0"}
 
 
 def _silhouette(part, pose):
