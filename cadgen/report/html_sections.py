@@ -294,17 +294,34 @@ def _cam_section(report: dict) -> str:
             + _key_values(shown) + _problem_list(cam.get("problems", [])))
     duckbill = report.get("duckbill")
     if duckbill:   # the linkage's return spring, roller and pins (cadgen.machine.duckbill)
-        spring = duckbill.get("spring") or {}
-        keys = ("designation", "wire", "mean_diameter", "active_coils", "free_length",
-                "installed_length", "working_length", "solid_length", "rate", "preload",
-                "force_max", "stress_max", "stress_allowed", "utilisation")
-        body += ("<h3>Duckbill linkage</h3>"
-                 + _key_values({"return spring": {k: spring[k] for k in keys if k in spring},
-                                "roller": duckbill["roller"],
-                                "loads": duckbill["follower"],
-                                "pins": {joint: pin["designation"]
-                                         for joint, pin in duckbill["pins"].items()}}))
+        body += "<h3>Duckbill linkage</h3>" + _key_values(_duckbill_rows(duckbill))
     return _section("cam", "Duckbill cam", body)
+
+
+#: The return spring's numbers the page shows: (report key, label with its unit).
+_SPRING_ROWS = (("designation", "designation"), ("wire", "wire (mm)"),
+                ("mean_diameter", "mean diameter (mm)"), ("active_coils", "active coils"),
+                ("free_length", "free length (mm)"), ("installed_length", "closed (mm)"),
+                ("working_length", "open (mm)"), ("least_working_length", "least (mm)"),
+                ("rate", "rate (N/mm)"), ("preload", "force closed (N)"),
+                ("force_max", "force open (N)"), ("stress_max", "corrected stress (MPa)"),
+                ("stress_allowed", "allowed, 0.5 Rm (MPa)"), ("utilisation", "utilisation"))
+
+
+def _duckbill_rows(duckbill: dict) -> dict:
+    spring, roller, loads = duckbill.get("spring") or {}, duckbill["roller"], duckbill["follower"]
+    return {
+        "return spring (EN 13906-1)": {label: spring[key] for key, label in _SPRING_ROWS
+                                       if key in spring},
+        "roller": {"bearing": roller["bearing"], "pin": roller["pin"], "ring": roller["ring"],
+                   "contact force (N)": f"{roller['contact_force_min_n']:.1f} to "
+                                        f"{roller['contact_force_max_n']:.1f}"},
+        "loads": {"largest need (N)": loads["needed_spring_force_max_n"],
+                  "at carrier angle (deg)": loads["needed_at_carrier_deg"],
+                  "safety factor": loads["safety_factor"],
+                  "carrier speed (r/min)": loads["carrier_speed_rpm"]},
+        "pins": {joint: pin["designation"] for joint, pin in duckbill["pins"].items()},
+    }
 
 
 def _solids_section(report: dict) -> str:
