@@ -204,7 +204,9 @@ def test_the_model_holds_the_linkage_with_one_freedom_and_the_bill_buys_it(paper
 
     # per arm: pins at H, G, P2, two at J, two at O1, each with a washer and a split pin
     assert count("clevis pin") == count("washer") == count("split pin") == 2 * 7
-    assert count("compression spring") == count("parallel pin") == count("retaining ring") == 2
+    # the roller pin's DIN 471 4 mm ring (the shafts' own rings are larger: machine.retention)
+    assert count("compression spring") == count("parallel pin") == 2
+    assert rows[("retaining ring", "DIN 471 4 x 0.4")] == 2
     assert rows[("bearing", "604")] == 2                 # the rollers, 12 mm across
     assert rows[("clevis pin", machine.fixings["duckbill"]["pins"]["G"]["designation"])] == 2
     made = {part.name: len(part.instances) for part in assembly.parts}

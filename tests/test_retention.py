@@ -25,7 +25,7 @@ def test_din_471_rings_as_the_standard_prints_them():
         "s": 1.0, "d2": 14.3, "m": 1.1, "n": 1.1, "d4": 22.6}
     assert (shaft_ring(20)["s"], shaft_ring(20)["d2"], shaft_ring(20)["m"]) == (1.2, 19.0, 1.3)
     assert (shaft_ring(30)["s"], shaft_ring(30)["d2"], shaft_ring(30)["m"]) == (1.5, 28.6, 1.6)
-    assert shaft_ring(17)["designation"] == "retaining ring DIN 471 17 x 1"
+    assert shaft_ring(17)["designation"] == "DIN 471 17 x 1"
     # the groove beyond the part and the shaft past it, to the half millimetre: 1.1 + 1.1
     assert ring_room(15) == 2.5
     with pytest.raises(CatalogueError, match="16 mm shaft"):

@@ -176,7 +176,7 @@ def _axial_stack(b, retention, shaft, me, copy, housing_of, parts_of):
             housing = housing_of(seat.housing)
             graph.rest(node, housing) if part.stop == "down" else graph.rest(housing, node)
         elif part.kind == "ring":
-            node = graph.part(f"{me}/ring-{part.ref}", f"{part.designation} on {me}")
+            node = graph.part(f"{me}/ring-{part.ref}", f"retaining ring {part.designation} on {me}")
         elif part.kind == "spacer":
             node = b.instance(f"spacer-{shaft.name}-{part.ref}", copy)
             graph.part(node, f"spacer {node}")
@@ -190,8 +190,8 @@ def _axial_stack(b, retention, shaft, me, copy, housing_of, parts_of):
     for lower, upper in retention.touching():
         graph.rest(nodes[id(upper)], nodes[id(lower)])
     count = len(retention.rings)
-    return ((Item("retaining ring", retention.rings[0].designation,
-                  retention.rings[0].designation, count),) if count else ())
+    ring = retention.rings[0].designation if count else ""
+    return (Item("retaining ring", f"retaining ring {ring}", ring, count),) if count else ()
 
 
 def _flange_items(flange) -> tuple:

@@ -142,7 +142,7 @@ def shaft_ring(d: float) -> dict:
     for row in _rows("retaining_rings"):
         if abs(float(row["d1"]) - float(d)) < 1e-9:
             ring = {name: float(value) for name, value in row.items()}
-            ring["designation"] = f"retaining ring DIN 471 {ring['d1']:g} x {ring['s']:g}"
+            ring["designation"] = f"DIN 471 {ring['d1']:g} x {ring['s']:g}"
             return ring
     sizes = ", ".join(row["d1"] for row in _rows("retaining_rings"))
     raise CatalogueError(f"no DIN 471 retaining ring in the table for a {float(d):g} mm shaft "

@@ -27,13 +27,15 @@ from kinematics.errors import Problem
 
 from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, planting_modules
 from cadgen.machine.bearings import journal_bore, select_bearing
-from cadgen.machine.catalogue import CatalogueError, bearings, bearings_with_bore, preferred_diameters
+from cadgen.machine.catalogue import (CatalogueError, bearings, bearings_with_bore,
+                                      preferred_diameters)
 from cadgen.machine.fits import process_fits
 from cadgen.machine.fastening import coupling_key, flange_problems, free_bearing
-from cadgen.machine.fixings import arm_fixings, fixings_report
+from cadgen.machine.fixings import arm_fixings, cam_bore_problems, fixings_report
 from cadgen.machine.layouts import (HOLLOW_WALL_MIN, _mount_fields, carry_flange, planting_axes,
                                     pricking_axes)
 from cadgen.machine.model import BearingSeat, Drivetrain, GearMount, HousingStack, Shaft
+from cadgen.machine.retention import drivetrain_retention
 from cadgen.machine.shafts import (RULES as SHAFT_RULES, beam_reactions, choose_diameter,
                                    hub_key, key_pressure, max_bending, required_diameter,
                                    shaft_core)
@@ -68,24 +70,6 @@ class _Sized:
     bearings: tuple               # (floor, roof): (Bearing, life, passed)
     overhang: float               # height of the external load from the cavity floor (or None)
     bore: float = 0.0             # a hollow shaft's bore
-
-
-def _cam_bore_problems(params, shafts) -> list:
-    """A cam bore given in the file that the E shaft does not turn freely in (planting).
-
-    The cam is fixed to gearbox 2 and the E shaft turns inside it, so its bore must be at
-    least the shaft's running hole (left out, the bore is that hole)."""
-    given = getattr(getattr(params, "cam", None), "bore_diameter", None)
-    if params.mechanism != "planting" or given is None:
-        return []
-    hole = next((seat.hole_diameter for shaft in shafts if shaft.name == "E"
-                 for seat in shaft.seats if seat.wall == "roof" and seat.through), None)
-    if hole is None or given >= hole - 1e-9:
-        return []
-    return [Problem("cam.bore_diameter", "cam_bore_too_small",
-                    f"the cam's bore of {given:g} mm is smaller than the {hole:g} mm the E shaft "
-                    "turns in (its diameter plus the running clearance): leave cam.bore_diameter "
-                    "out, or give at least that")]
 
 
 # ------------------------------------------------------------------ sizing
@@ -475,7 +459,7 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
                                 f"the sleeve carrying gearbox 1 is {sleeve.diameter:g} mm, more "
                                 f"than the {DRIVE_SLEEVE_DIAMETER:g} mm the drive's driven gear "
                                 "was designed round"))
-    problems += _cam_bore_problems(params, shafts)
+    problems += cam_bore_problems(params, shafts)
     shafts, fixings, found = arm_fixings(params, shafts, stacks, fits, cam)
     problems += found
     if params.mechanism == "planting" and cam is not None:   # the duckbill linkage's parts,
@@ -514,12 +498,8 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
         rules["stack_bases_mm"] = base
     if held is not None:
         rules["case_drive"] = held
-    from cadgen.machine.retention import shaft_retention
-
-    held = {"E": "planter", "planet": "rocker"}   # the arm's hub beyond its shaft's housing
-    retention = tuple(shaft_retention(s, stacks, base, fixings.get(held.get(s.name)),
-                                      params.housing.axial_gap) for s in shafts)
-    problems += [p for r in retention if r.side == 1 for p in r.problems]
+    retention, found = drivetrain_retention(shafts, stacks, base, fixings, params.housing.axial_gap)
+    problems += found
     return Drivetrain(params.mechanism, tuple(shafts), stacks, fits.process, rules,
                       tuple(problems), drive, base, fixings, retention)
 

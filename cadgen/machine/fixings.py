@@ -28,7 +28,7 @@ from cadgen.machine.shafts import KEYLESS_BELOW, FLAT_DEPTH_RATIO, key_for_shaft
 
 __all__ = ["keyed_hub", "screwed_plate", "needle_clamp", "arm_fixings", "fixings_report",
            "dowel_pins", "seat_misalignment", "BEARING_MISALIGNMENT_ARCMIN", "TAP_DRILL",
-           "COUNTERBORE",
+           "COUNTERBORE", "cam_bore_problems",
            "HUB_CHAMFER", "HUB_OUTSIDE_RATIO", "HUB_LENGTH_MAX_RATIO"]
 
 #: Tap drill diameters for coarse threads, ISO 2306 (mm).
@@ -297,3 +297,21 @@ def fixings_report(fixings: dict) -> dict:
         out[name] = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                      for k, v in entry.items()}
     return out
+
+
+def cam_bore_problems(params, shafts) -> list:
+    """A cam bore given in the file that the E shaft does not turn freely in (planting).
+
+    The cam is fixed to gearbox 2 and the E shaft turns inside it, so its bore must be at
+    least the shaft's running hole (left out, the bore is that hole)."""
+    given = getattr(getattr(params, "cam", None), "bore_diameter", None)
+    if params.mechanism != "planting" or given is None:
+        return []
+    hole = next((seat.hole_diameter for shaft in shafts if shaft.name == "E"
+                 for seat in shaft.seats if seat.wall == "roof" and seat.through), None)
+    if hole is None or given >= hole - 1e-9:
+        return []
+    return [Problem("cam.bore_diameter", "cam_bore_too_small",
+                    f"the cam's bore of {given:g} mm is smaller than the {hole:g} mm the E shaft "
+                    "turns in (its diameter plus the running clearance): leave cam.bore_diameter "
+                    "out, or give at least that")]

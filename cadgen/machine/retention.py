@@ -37,7 +37,7 @@ from cadgen.machine.catalogue import CatalogueError, shaft_ring
 from kinematics.errors import Problem
 
 __all__ = ["AXIAL_PLAY", "MIN_SPACER", "RING_CLEARANCE", "SPACER_BORE_CLEARANCE", "MAX_PLAY", "StackPart",
-           "ShaftRetention", "ring_room", "spacer_outside", "set_screw", "shaft_retention",
+           "ShaftRetention", "ring_room", "drivetrain_retention", "spacer_outside", "set_screw", "shaft_retention",
            "retention_report"]
 
 #: Axial play (mm) left in a stack held between two shoulders: the bearings are not preloaded
@@ -273,6 +273,18 @@ def shaft_retention(shaft, stacks, bases, hub=None, axial_gap: float = 0.0) -> S
     everything = sorted(held + spacers + ring_parts, key=lambda p: (p.z0, p.z1))
     return ShaftRetention(shaft.name, shaft.side, tuple(everything), tuple(screws),
                           tuple(problems))
+
+
+#: The part keyed on each shaft outside its housing (its fixing's name in the drivetrain).
+OUTSIDE_HUBS = {"E": "planter", "planet": "rocker"}
+
+
+def drivetrain_retention(shafts, stacks, bases, fixings, axial_gap: float) -> tuple:
+    """``(retention, problems)``: every shaft's :func:`shaft_retention` (the hubs outside the
+    housings from ``fixings``), and the problems of side 1's (side 2 repeats them)."""
+    retention = tuple(shaft_retention(s, stacks, bases, fixings.get(OUTSIDE_HUBS.get(s.name)),
+                                      axial_gap) for s in shafts)
+    return retention, [p for r in retention if r.side == 1 for p in r.problems]
 
 
 def retention_report(retentions) -> list:

@@ -232,7 +232,7 @@ def _stack_words(part: dict) -> str:
     if part["kind"] == "spacer":
         return f"spacer {_number(length, 2)} mm"
     if part["kind"] == "ring":
-        return part["designation"].replace("retaining ring ", "ring ")
+        return "ring " + part["designation"]
     return part["part"]
 
 
