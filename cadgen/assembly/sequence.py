@@ -30,8 +30,12 @@ _BASE = re.compile(r"-base(-\d+)?(-(arm|side)\d)?$")
 
 #: Tightening torque (N m) of ISO 4762 / ISO 4017 screws of class 8.8 with a friction
 #: coefficient of 0.14 in thread and head (the usual table from VDI 2230, 90 % of the yield
-#: point); into a tapped aluminium housing take no more than 80 % of it.
-TIGHTENING_TORQUE_NM = {"M3": 1.3, "M4": 3.0, "M5": 5.9, "M6": 10.1, "M8": 24.6}
+#: point); into a tapped aluminium housing take no more than 80 % of it. The values as Röhm's
+#: DURO-M operating manual tabulates them for ISO 4762 8.8 (1.27, 3.0, 5.9, 10.1, 24.6, 48,
+#: 84 N m for M3 to M12); other makers' tables at 0.14 round them to 1.3, 2.9-3.0, 5.9-6, 10,
+#: 25, 49, 85.
+TIGHTENING_TORQUE_NM = {"M3": 1.3, "M4": 3.0, "M5": 5.9, "M6": 10.1, "M8": 24.6, "M10": 48.0,
+                        "M12": 84.0}
 #: Joint kinds that hold a part in place: one step each.
 HOLDING = ("fixed", "revolute", "prismatic", "slot")
 
