@@ -119,7 +119,8 @@ def test_viewer_takes_binary_gltf_only():
         viewer_section(b"solid ascii stl")
     section = viewer_section(b"glTF" + bytes(16))
     assert 'id="cadgen-glb">Z2xURg' in section and "CadgenThree" in section
-    assert section.count("</script>") == 3   # the GLB, three.js, the viewer: none cut short
+    # the GLB, three.js, the explode helpers, the viewer: none cut short
+    assert section.count("</script>") == 4 and "CadgenExplode" in section
 
 
 # ---------------------------------------------------------------- contents, folding, the 3D view
@@ -250,3 +251,44 @@ def test_the_3d_view_shows_every_part_of_the_file_named_and_placed(browser, repo
     for name, box in expected.items():   # same place, within the thinning's tolerance (m)
         assert np.allclose(parts[name], box, atol=1.5e-4), name
     assert embedded < len(glb) * 4 / 3   # the page embeds less than the file's base64
+
+
+@pytest.mark.parametrize("design", ["xin2024-planter", "kernel-a"], ids=["planting", "pricking"])
+def test_the_explode_slider_moves_each_part_by_its_offset(browser, reports, design):
+    """The slider at t moves each part by t times the offset its GLB node carries (extras
+    "explode", metres) and every part stays in the picture (the camera follows); back at 0
+    every part is where the file places it."""
+    import numpy as np
+
+    from cadgen.report.view_glb import read_glb
+
+    gltf, _ = read_glb((reports[design].parent / "solids" / "assembly.glb").read_bytes())
+    offsets = {node["name"]: np.array(node["extras"]["explode"]) for node in gltf["nodes"]
+               if "explode" in node.get("extras", {})}
+    assert len(offsets) >= 5
+    context, page = _open(browser, reports[design])
+    try:
+        page.wait_for_function("window.cadgenViewer && window.cadgenViewer.state === 'ready'")
+        assembled = page.evaluate("window.cadgenViewer.parts")
+        assert page.evaluate("window.cadgenViewer.exploding") == len(offsets)
+        assert page.evaluate("window.cadgenViewer.inPicture") is True
+        slider = page.locator(".viewer-explode input")
+        assert slider.is_visible()
+        found = {}
+        for t in ("1", "0.5", "0"):
+            slider.fill(t)
+            page.wait_for_function(f"window.cadgenViewer.explode === {t}")
+            found[t] = (page.evaluate("window.cadgenViewer.parts"),
+                        page.evaluate("window.cadgenViewer.inPicture"))
+    finally:
+        context.close()
+    for t, (parts, in_picture) in found.items():
+        assert in_picture, t
+        for name, box in assembled.items():
+            moved = float(t) * offsets.get(name, np.zeros(3))
+            assert np.allclose(parts[name], np.r_[np.add(box[:3], moved), np.add(box[3:], moved)],
+                               atol=1e-6), (t, name)
+    # fully apart the parts' boxes spread further than assembled, along the shaft axes (z)
+    spread = {t: np.ptp([b[i] for n, b in parts.items() if not n.startswith("ground")
+                         for i in (2, 5)]) for t, (parts, _) in found.items()}
+    assert spread["1"] > 1.5 * spread["0"]

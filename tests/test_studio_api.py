@@ -501,6 +501,9 @@ def test_design_and_static_page(client):
     viewer = client.get("/static/vendor/three-viewer.min.js")   # no token for the page
     assert viewer.status_code == 200
     assert viewer.content == (REPO / "cadgen/report/vendor/three-viewer.min.js").read_bytes()
+    explode = client.get("/static/vendor/explode.js")   # the report's explode slider's helpers
+    assert explode.status_code == 200
+    assert explode.content == (REPO / "cadgen/report/explode.js").read_bytes()
     if (REPO / "cadgen/studio/static/index.html").is_file():
         page = client.get("/")
         assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")

@@ -242,3 +242,13 @@ def test_build_reports_its_stages_links_the_report_and_shows_the_assembly(page, 
     assert viewer["meshes"] >= 4 and viewer["covers"] >= 1
     page.locator(".viewer-buttons button", has_text="Hide housing covers").click()
     assert page.evaluate("window.cadgenStudio.build.viewer.state.coversHidden") is True
+    # the explode slider takes the parts apart by the offsets in the GLB's nodes
+    assert viewer["exploding"] >= 4 and viewer["explode"] == 0
+    placed = page.evaluate("""() => window.cadgenStudio.build.viewer.exploding.map(
+        p => p.node.position.toArray())""")
+    page.locator(".viewer-explode input").fill("1")
+    assert page.evaluate("window.cadgenStudio.build.viewer.state.explode") == 1
+    moved = page.evaluate("""() => window.cadgenStudio.build.viewer.exploding.map(
+        p => [p.node.position.toArray(), p.offset])""")
+    for before, (after, offset) in zip(placed, moved, strict=True):
+        assert after == pytest.approx([b + o for b, o in zip(before, offset)], abs=1e-9)

@@ -281,8 +281,9 @@ def _material(kind: str):
                        doubleSided=see_through)
 
 
-def _glb(parts) -> bytes:
-    """Binary glTF 2.0 of checked parts, in metres (see the module notes), by trimesh."""
+def _glb(parts, extras=None) -> bytes:
+    """Binary glTF 2.0 of checked parts, in metres (see the module notes), by trimesh; each
+    node's ``extras`` from ``extras`` (``{part name: dict}``), if any."""
     import trimesh
     from trimesh.exchange.gltf import export_glb
 
@@ -294,11 +295,12 @@ def _glb(parts) -> bytes:
         placed = np.array(transform, dtype=float)
         placed[:3, 3] *= GLTF_METRES_PER_MM
         material = material_key(name, kind)
+        node_extras = (extras or {}).get(name) or None
         key = hashlib.sha256(material.encode() + b"\0" + np.ascontiguousarray(mesh.vertices).tobytes()
                              + np.ascontiguousarray(mesh.faces).tobytes()).digest()
         if key in shared:
             scene.graph.update(frame_to=name, frame_from=scene.graph.base_frame,
-                               geometry=shared[key], matrix=placed)
+                               geometry=shared[key], matrix=placed, metadata=node_extras)
             continue
         # vertices split where faces meet at more than the crease angle, each corner's normal
         # from its own smooth neighbourhood only (trimesh's smoothing groups let a normal
@@ -307,7 +309,8 @@ def _glb(parts) -> bytes:
         shaded = trimesh.Trimesh(positions * GLTF_METRES_PER_MM, triangles,
                                  vertex_normals=normals, process=False)
         shaded.visual = trimesh.visual.TextureVisuals(material=_material(material))
-        scene.add_geometry(shaded, node_name=name, geom_name=name, transform=placed)
+        scene.add_geometry(shaded, node_name=name, geom_name=name, transform=placed,
+                           metadata=node_extras)
         shared[key] = name
     return export_glb(scene, include_normals=True)
 
@@ -353,7 +356,8 @@ def _deterministic_3mf(data: bytes) -> bytes:
     return out.getvalue()
 
 
-def assembly_bytes(parts, file_type: str | AssemblyFormat = AssemblyFormat.GLB) -> bytes:
+def assembly_bytes(parts, file_type: str | AssemblyFormat = AssemblyFormat.GLB, *,
+                   extras=None) -> bytes:
     """An assembly file: one named node per part, placed by its transform.
 
     Parameters
@@ -363,6 +367,9 @@ def assembly_bytes(parts, file_type: str | AssemblyFormat = AssemblyFormat.GLB) 
         the part's frame, homogeneous transforms part frame -> assembly frame (mm),
         and the part's kind (a key of :data:`PART_MATERIALS`; its material in a GLB).
     file_type : {"glb", "3mf"} or AssemblyFormat
+    extras : dict, optional
+        ``{part name: JSON-able dict}``: each GLB node's ``extras`` (the viewers read
+        ``"explode"``, :func:`cadgen.solids.explode.explode_offsets` in metres); not in 3MF.
 
     Returns
     -------
@@ -384,7 +391,7 @@ def assembly_bytes(parts, file_type: str | AssemblyFormat = AssemblyFormat.GLB) 
     if kind is AssemblyFormat.THREE_MF:
         writer = _three_mf_writer()  # before building anything: fail fast
         return _deterministic_3mf(writer(_scene(parts)))
-    return _glb(_checked(parts))
+    return _glb(_checked(parts), extras)
 
 
 def load_volume(data: bytes, file_type: str) -> float:
@@ -468,6 +475,14 @@ def solids_files(outcome):
     def assembly():
         placed = [(name, part.mesh, pose, part.kind) for name, part, pose
                   in outcome.assembly.placements(outcome.carrier_angle)]
-        return assembly_bytes(placed, outcome.file_type)
+        extras = None
+        if outcome.file_type == AssemblyFormat.GLB.value:   # the views' explode slider
+            from cadgen.solids.explode import explode_offsets
+
+            offsets = explode_offsets(outcome.assembly, outcome.carrier_angle)
+            extras = {name: {"explode": [round(float(v) * GLTF_METRES_PER_MM, 7)
+                                         for v in offset]}
+                      for name, offset in offsets.items() if np.any(offset)}
+        return assembly_bytes(placed, outcome.file_type, extras=extras)
 
     yield f"assembly.{outcome.file_type}", outcome.once("assembly", assembly)

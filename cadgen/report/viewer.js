@@ -38,6 +38,9 @@
   var controls = new T.OrbitControls(camera, canvas);
   var home = null;
   var covers = [];   // the housings' covers (nodes named <housing>-cover...): hideable
+  // the explode slider's parts (window.CadgenExplode, explode.js), the framed meshes' boxes
+  var E = window.CadgenExplode, exploding = [], framed = [], meshes = [], grounds = [];
+  state.explode = 0;
 
   function render() {
     renderer.render(scene, camera);
@@ -50,11 +53,48 @@
     camera.updateProjectionMatrix();
     render();
   }
+  // front view (x forward to the right, y up), turned a little to show the axial stack
+  var HOME = new T.Vector3(0.45, 0.25, 1).normalize();
+  function frame(fit) {
+    // the whole (bounding sphere) in the picture
+    var centre = fit.getCenter(new T.Vector3()), size = fit.getSize(new T.Vector3());
+    var distance = 0.55 * size.length() / Math.sin(Math.PI * 35 / 360);
+    var direction = HOME;
+    camera.near = distance / 100;
+    camera.far = distance * 20;
+    camera.updateProjectionMatrix();
+    return {position: centre.clone().addScaledVector(direction, distance), target: centre.clone()};
+  }
   function goHome() {
     if (!home) return;
+    frame(home.fit);
     camera.position.copy(home.position);
     controls.target.copy(home.target);
     controls.update();
+    // then as far apart as the slider has the machine, framed as the slider frames it
+    if (state.explode > 0) E.follow(T, camera, controls, framed, HOME, 0, state.explode);
+    render();
+  }
+  function recordParts() {
+    meshes.forEach(function (node) {
+      var box = new T.Box3().setFromObject(node, true);
+      state.parts[node.userData.cadgenName] = box.min.toArray().concat(box.max.toArray());
+    });
+    // whether every framed part's box lies in the picture (the camera's view of it)
+    camera.updateMatrixWorld();
+    state.inPicture = !E || !framed.length || E.corners(T, framed, state.explode).every(
+      function (corner) {
+        var seen = corner.project(camera);
+        return Math.abs(seen.x) <= 1 && Math.abs(seen.y) <= 1;
+      });
+  }
+  function explodeTo(value) {
+    var t = state.explode;
+    state.explode = E.apply(exploding, value);
+    E.follow(T, camera, controls, framed, HOME, t, state.explode);
+    // the soil is no part of the machine: off while it is apart
+    grounds.forEach(function (node) { node.visible = state.explode === 0; });
+    recordParts();
     render();
   }
 
@@ -63,7 +103,7 @@
   for (var i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
   new T.GLTFLoader().parse(bytes.buffer, "", function (gltf) {
     var model = gltf.scene;   // in metres, glTF's unit, as the GLB is written
-    var fit = new T.Box3();
+    var fit = new T.Box3(), framedMeshes = [];
     model.updateMatrixWorld(true);
     model.traverse(function (node) {
       if (!node.isMesh) return;
@@ -72,25 +112,32 @@
       // drawn from both sides since a housing's cavity faces inwards
       if (node.material) node.material.side = T.DoubleSide;
       state.meshes += 1;
-      var box = new T.Box3().setFromObject(node, true);
-      state.parts[name] = box.min.toArray().concat(box.max.toArray());
+      node.userData.cadgenName = name;
+      meshes.push(node);
       if (/-cover(-|$)/.test(name)) covers.push(node);
-      if (!/^ground/.test(name)) fit.expandByObject(node);   // the soil slab is wide: not framed
+      if (!/^ground/.test(name)) {   // the soil slab is wide: not framed
+        fit.expandByObject(node);
+        framedMeshes.push(node);
+      } else {
+        grounds.push(node);
+      }
     });
     if (fit.isEmpty()) fit.setFromObject(model);
     scene.add(model);
-    var centre = fit.getCenter(new T.Vector3()), size = fit.getSize(new T.Vector3());
-    var distance = 0.55 * size.length() / Math.sin(Math.PI * 35 / 360);   // the bounding sphere
-    // front view (x forward to the right, y up), turned a little to show the axial stack
-    var direction = new T.Vector3(0.45, 0.25, 1).normalize();
-    home = {position: centre.clone().addScaledVector(direction, distance), target: centre.clone()};
-    camera.near = distance / 100;
-    camera.far = distance * 20;
+    home = frame(fit);
+    home.fit = fit;
+    if (E) {
+      exploding = E.parts(model);
+      framed = E.boxes(T, framedMeshes, exploding);
+    }
     controls.addEventListener("change", render);
     goHome();
     resize();
+    recordParts();
     state.covers = covers.length;
+    state.exploding = exploding.length;
     if (covers.length) root.querySelector(".viewer-covers").hidden = false;
+    if (exploding.length) root.querySelector(".viewer-explode").hidden = false;
     state.state = "ready";
     root.setAttribute("data-state", "ready");
   }, function (error) {
@@ -98,6 +145,9 @@
   });
 
   root.querySelector(".viewer-home").addEventListener("click", goHome);
+  root.querySelector(".viewer-explode input").addEventListener("input", function (event) {
+    if (exploding.length) explodeTo(event.target.value);
+  });
   root.querySelector(".viewer-covers").addEventListener("click", function (event) {
     var hide = covers.length && covers[0].visible;
     covers.forEach(function (node) { node.visible = !hide; });

@@ -5,8 +5,9 @@ every part, named and placed as in the file, with fewer vertices and smaller num
 the file stays as written) as base64, drawn by a vendored build of three.js
 (``vendor/three-viewer.min.js``: WebGLRenderer, GLTFLoader, OrbitControls; its
 version and how it was built are in ``vendor/README.md``), inlined with a small
-script of ours (``viewer.js``): the page fetches nothing, so it works from an
-e-mail attachment or an offline laptop. The GLB is in metres (glTF's unit), as
+script of ours (``viewer.js``, with ``explode.js``: the explode slider, which moves each part
+by the offset its GLB node carries, :mod:`cadgen.solids.explode`): the page fetches nothing,
+so it works from an e-mail attachment or an offline laptop. The GLB is in metres (glTF's unit), as
 the view is: it is drawn unscaled.
 
 :func:`interactive_sections` is what the page calls: the animation section
@@ -82,15 +83,24 @@ def viewer_section(glb: bytes | None, light: bytes | None = None) -> str:
     return _section("view-3d", "3D view of the assembly", (
         f'<p class="note">{shown}: drag to turn, scroll to zoom, right-drag to pan. Housing '
         "covers, and the soil of a field run, are drawn see-through; "
-        "\u201cHide covers\u201d takes the covers off to show the gears and shafts. Drawn with "
+        "\u201cHide covers\u201d takes the covers off to show the gears and shafts. "
+        "\u201cExplode\u201d takes the machine apart in its assembly order (0 assembled, 1 "
+        "apart): each part moves off what it goes onto the way it goes on, along the shafts "
+        "(a shaft out of its base towards the cover's side, the cover above the shafts, the "
+        "next housing above that, the gears spread along their shafts), and the arms also "
+        "out from the carrier. Drawn with "
         f"three.js {THREE_VERSION} (MIT), inlined: nothing is fetched.</p>"
         '<div class="viewer" id="cadgen-viewer" data-state="loading">'
         '<canvas aria-label="3D view of the assembly"></canvas>'
         '<p class="viewer-message" hidden></p>'
         '<button type="button" class="viewer-home">Reset view</button>'
-        '<button type="button" class="viewer-covers" hidden>Hide covers</button></div>'
+        '<button type="button" class="viewer-covers" hidden>Hide covers</button>'
+        '<label class="viewer-explode" hidden>Explode <input type="range" min="0" max="1" '
+        'step="0.01" value="0" aria-label="Explode the assembly: 0 assembled, 1 taken apart">'
+        '</label></div>'
         f'<script type="application/octet-stream" id="cadgen-glb">{encoded}</script>'
-        f"<script>{vendor}</script><script>{_resource('viewer.js')}</script>"))
+        f"<script>{vendor}</script><script>{_resource('explode.js')}</script>"
+        f"<script>{_resource('viewer.js')}</script>"))
 
 
 def interactive_sections(animation: dict | None = None, glb: bytes | None = None,

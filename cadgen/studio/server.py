@@ -4,7 +4,8 @@ Routes (see docs/studio.md for the answers' shapes):
 
 - ``GET /`` and ``GET /static/...``: the page (no token: they hold no data);
   ``/static/vendor/three-viewer.min.js`` is the report's vendored three.js build, served
-  from ``cadgen/report/vendor`` (one copy in the repository);
+  from ``cadgen/report/vendor`` (one copy in the repository), ``/static/vendor/explode.js``
+  the report's explode slider's helpers (``cadgen/report/explode.js``);
 - ``GET /api/design``, ``GET /api/schema``, ``POST /api/evaluate``, ``POST /api/save``,
   ``POST /api/build``, ``GET /api/build/<id>/events`` and ``GET /files/<path>`` (the build
   outputs under the output root): each needs the token.
@@ -52,6 +53,7 @@ LOOPBACK_HOSTS = ("127.0.0.1", "localhost")
 
 _STATIC = Path(__file__).with_name("static")
 _THREE_VIEWER = Path(__file__).parent.parent / "report" / "vendor" / "three-viewer.min.js"
+_EXPLODE = Path(__file__).parent.parent / "report" / "explode.js"
 
 log = logging.getLogger("cadgen.studio")
 
@@ -368,6 +370,10 @@ def create_app(path: Path | None, *, token: str, output_root: Path, port: int | 
     @app.get("/static/vendor/three-viewer.min.js", include_in_schema=False)
     async def three_viewer():
         return FileResponse(_THREE_VIEWER, media_type="text/javascript")
+
+    @app.get("/static/vendor/explode.js", include_in_schema=False)
+    async def explode_helpers():
+        return FileResponse(_EXPLODE, media_type="text/javascript")
 
     # ---------------------------------------------------------------- the API
     @app.get("/api/design")

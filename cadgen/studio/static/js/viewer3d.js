@@ -1,7 +1,12 @@
 // cadgen studio: the 3D view of a build's assembly.glb, with the report's vendored three.js
 // bundle (window.CadgenThree, served at /static/vendor/three-viewer.min.js). The same framing
 // and the same cover rule as the report's viewer (cadgen/report/viewer.js, which reads a GLB
-// embedded in its page; here the GLB is loaded from the build's /files URL with the token).
+// embedded in its page; here the GLB is loaded from the build's /files URL with the token), and
+// the same explode slider (window.CadgenExplode: cadgen/report/explode.js, served at
+// /static/vendor/explode.js; the offsets are in the GLB's nodes).
+
+// front view (x forward to the right, y up), turned a little to show the axial stack
+const HOME = [0.45, 0.25, 1];
 
 export class AssemblyViewer {
   constructor(container) {
@@ -20,11 +25,21 @@ export class AssemblyViewer {
       {type: "button", textContent: "Hide housing covers", hidden: true});
     this.coversButton.setAttribute("aria-pressed", "false");
     buttons.append(this.homeButton, this.coversButton);
-    this.root.append(this.canvas, buttons, this.message);
+    this.explodeLabel = Object.assign(document.createElement("label"),
+      {className: "viewer-explode", textContent: "Explode ", hidden: true});
+    this.explodeInput = Object.assign(document.createElement("input"),
+      {type: "range", min: "0", max: "1", step: "0.01", value: "0"});
+    this.explodeInput.setAttribute("aria-label", "Explode the assembly: 0 assembled, 1 taken apart");
+    this.explodeLabel.append(this.explodeInput);
+    this.root.append(this.canvas, buttons, this.explodeLabel, this.message);
     container.appendChild(this.root);
-    this.state = {state: "empty", meshes: 0, covers: 0, coversHidden: false};
+    this.state = {state: "empty", meshes: 0, covers: 0, coversHidden: false, explode: 0, exploding: 0};
+    this.exploding = [];
+    this.framed = [];
+    this.grounds = [];
     this.homeButton.addEventListener("click", () => this.goHome());
     this.coversButton.addEventListener("click", () => this.toggleCovers());
+    this.explodeInput.addEventListener("input", () => this.explodeTo(this.explodeInput.value));
   }
 
   fail(kind, text) {
@@ -76,6 +91,24 @@ export class AssemblyViewer {
     this.camera.position.copy(this.home.position);
     this.controls.target.copy(this.home.target);
     this.controls.update();
+    // then as far apart as the slider has the machine, framed as the slider frames it
+    if (this.state.explode > 0) {
+      const T = window.CadgenThree;
+      window.CadgenExplode.follow(T, this.camera, this.controls, this.framed,
+                                  new T.Vector3(...HOME), 0, this.state.explode);
+    }
+    this.render();
+  }
+
+  /** Each part `value` (0 assembled .. 1 apart) of its way out; the camera follows. */
+  explodeTo(value) {
+    const E = window.CadgenExplode, T = window.CadgenThree;
+    if (!E || !this.exploding.length) return;
+    const before = this.state.explode;
+    this.state.explode = E.apply(this.exploding, value);
+    E.follow(T, this.camera, this.controls, this.framed, new T.Vector3(...HOME), before,
+             this.state.explode);
+    this.grounds.forEach((node) => { node.visible = this.state.explode === 0; });   // no soil apart
     this.render();
   }
 
@@ -90,7 +123,8 @@ export class AssemblyViewer {
       if (this.model) this.scene.remove(this.model);
       const model = this.model = gltf.scene;   // metres, glTF's unit
       this.covers = [];
-      const fit = new T.Box3();
+      this.grounds = [];
+      const fit = new T.Box3(), framed = [];
       model.updateMatrixWorld(true);
       let meshes = 0;
       model.traverse((node) => {
@@ -99,19 +133,31 @@ export class AssemblyViewer {
         if (node.material) node.material.side = T.DoubleSide;   // housings' cavities face inwards
         meshes += 1;
         if (/-cover(-|$)/.test(name)) this.covers.push(node);
-        if (!/^ground/.test(name)) fit.expandByObject(node);   // the soil slab is wide: not framed
+        if (/^ground/.test(name)) {
+          this.grounds.push(node);
+        } else {   // the soil slab is wide: not framed
+          fit.expandByObject(node);
+          framed.push(node);
+        }
       });
       if (fit.isEmpty()) fit.setFromObject(model);
       this.scene.add(model);
       const centre = fit.getCenter(new T.Vector3()), size = fit.getSize(new T.Vector3());
       const distance = 0.55 * size.length() / Math.sin(Math.PI * 35 / 360);
-      const direction = new T.Vector3(0.45, 0.25, 1).normalize();
+      const direction = new T.Vector3(...HOME).normalize();
       this.home = {position: centre.clone().addScaledVector(direction, distance), target: centre.clone()};
       this.camera.near = distance / 100;
       this.camera.far = distance * 20;
+      const E = window.CadgenExplode;   // the new model comes assembled
+      this.exploding = E ? E.parts(model) : [];
+      this.framed = E ? E.boxes(T, framed, this.exploding) : [];
+      this.state.explode = 0;
+      this.explodeInput.value = "0";
+      this.explodeLabel.hidden = this.exploding.length === 0;
       this.goHome();
       this.resize();
-      Object.assign(this.state, {state: "ready", meshes, covers: this.covers.length, coversHidden: false});
+      Object.assign(this.state, {state: "ready", meshes, covers: this.covers.length, coversHidden: false,
+                                 explode: 0, exploding: this.exploding.length});
       this.coversButton.hidden = this.covers.length === 0;
       this.coversButton.textContent = "Hide housing covers";
       this.root.dataset.state = "ready";
