@@ -198,42 +198,51 @@ def _pin_end_zone(fixing, centre, axis, start: float, segments):
             + _cylinder_z(centre, radius, axis - end, axis - start, segments))
 
 
+def _union(solids):
+    """One solid of several (manifold3d's batch union: one pass, not one per pair)."""
+    m3d = _engine()
+    return m3d.Manifold.batch_boolean(list(solids), m3d.OpType.Add)
+
+
 def shell_features(shell, fixing, layout, segments: int):
-    """The planter shell with the lever's lug, the rod's web, the G slot and the hinge ears."""
+    """The planter shell with the lever's lug, the rod's web, the G slot and the hinge ears.
+
+    What is added and what is cut are each gathered into one solid first, so the large shell
+    meets two booleans, not one per feature."""
     points, lug = fixing["points"], fixing["lug"]
     arm_top = layout.arm_bottom + layout.arm_thickness
     h = points["H"]
-    lug_outline = stadium(h, (h[0], 0.0), lug["radius"], lug["radius"], segments)
-    shell += _prism(lug_outline, layout.arm_bottom, arm_top, path="planter.arm_thickness")
-    shell -= _cylinder_z(h, fixing["lever"]["hole"]["H"] / 2, layout.arm_bottom - 1, arm_top + 1,
-                         segments)
+    adds = [_prism(stadium(h, (h[0], 0.0), lug["radius"], lug["radius"], segments),
+                   layout.arm_bottom, arm_top, path="planter.arm_thickness")]
+    cuts = [_cylinder_z(h, fixing["lever"]["hole"]["H"] / 2, layout.arm_bottom - 1, arm_top + 1,
+                        segments)]
     x, axis = -fixing["L1"], layout.tube_axis
     inner = _inner_radius(fixing)
     web = fixing["web"]
     # the web reaches half into the tube's wall, so the two are one solid
     web_top = web["bottom"] + web["thickness"]
-    shell += (_cylinder_y(x, axis, (inner + layout.tube_radius) / 2, web["bottom"], web_top,
-                          segments)
-              - _cylinder_y(x, axis, web["hole"] / 2, web["bottom"] - 1, web_top + 1, segments))
+    adds.append(_cylinder_y(x, axis, (inner + layout.tube_radius) / 2, web["bottom"], web_top,
+                            segments)
+                - _cylinder_y(x, axis, web["hole"] / 2, web["bottom"] - 1, web_top + 1, segments))
     # the slot in the tube's wall (the side towards the plate) the pin G rides in
     slot = fixing["tube_slot"]
     half, g = slot["width"] / 2, points["G"][0]
     window = stadium((g, slot["bottom"] + half), (g, slot["top"] - half), half, half, segments)
-    shell -= _prism(window, axis - layout.tube_radius - 1.0, axis - inner + 1.0)
+    cuts.append(_prism(window, axis - layout.tube_radius - 1.0, axis - inner + 1.0))
     hinge = fixing["hinge"]
+    beyond = hinge["ear_from"] + hinge["ear_thickness"]
     for centre, _ in _hinges(fixing).values():
         ear_outline = stadium(centre, centre + np.array([0.0, hinge["ear_radius"] + 4.0]),
                               hinge["ear_radius"], hinge["ear_radius"], segments)
         # room for the knuckle, and for the pin's ends beyond the ears
-        shell -= _cylinder_z(centre, hinge["knuckle_radius"] + hinge["clearance"],
-                             axis - hinge["ear_from"], axis + hinge["ear_from"], segments)
-        beyond = hinge["ear_from"] + hinge["ear_thickness"]
-        shell -= _pin_end_zone(fixing, centre, axis, beyond, segments)
+        cuts.append(_cylinder_z(centre, hinge["knuckle_radius"] + hinge["clearance"],
+                                axis - hinge["ear_from"], axis + hinge["ear_from"], segments))
+        cuts.append(_pin_end_zone(fixing, centre, axis, beyond, segments))
         for sign in (1.0, -1.0):
             near, far = sorted((axis + sign * hinge["ear_from"], axis + sign * beyond))
-            shell += _prism(ear_outline, near, far, [_hole(centre, hinge["hole"], segments)],
-                            path="planter.shell_wall")
-    return shell
+            adds.append(_prism(ear_outline, near, far, [_hole(centre, hinge["hole"], segments)],
+                               path="planter.shell_wall"))
+    return _union([shell] + adds) - _union(cuts)
 
 
 def _inner_radius(fixing) -> float:
@@ -251,8 +260,8 @@ def blade_features(blade, side: str, fixing, layout, segments: int):
     half = fixing["crank"]["thickness"] / 2
     lug = _prism(stadium(hinge, crank, spec["knuckle_radius"], fixing["crank"]["eye_radius"],
                          segments), axis - half, axis + half, path="cam.duckbill.blade_crank")
-    blade = (blade - _pin_end_zone(fixing, hinge, axis, spec["knuckle_half"], segments)
-             + knuckle + lug)
-    blade -= _cylinder_z(hinge, spec["hole"] / 2, axis - 20, axis + 20, segments)
-    blade -= _cylinder_z(crank, fixing["crank"]["hole"] / 2, axis - 5, axis + 5, segments)
-    return blade
+    blade = _union([blade - _pin_end_zone(fixing, hinge, axis, spec["knuckle_half"], segments),
+                    knuckle, lug])
+    return blade - _union([_cylinder_z(hinge, spec["hole"] / 2, axis - 20, axis + 20, segments),
+                           _cylinder_z(crank, fixing["crank"]["hole"] / 2, axis - 5, axis + 5,
+                                       segments)])
