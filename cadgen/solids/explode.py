@@ -48,6 +48,8 @@ _UP = np.array([0.0, 0.0, 1.0])
 #: Gears whose middles are this close along z (mm) are in one layer.
 _LEVEL_TOLERANCE = 0.5
 _PAD = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, 1.0]])
+#: The kinds a shaft carries with it: put in together, spread along it.
+RIDING = ({"gear", "shaft"}, {"spacer", "shaft"})
 
 
 def _boxes(assembly, phi: float) -> tuple[dict, dict]:
@@ -156,10 +158,11 @@ def explode_offsets(assembly, phi: float, *, gap: float | None = None) -> dict:
         extent = np.ptp(np.vstack(solid), axis=0)
         gap = GAP_FRACTION * float(extent.max())
     steps = [s for s in assembly_sequence(model) if s["part"] in boxes and s["onto"] in boxes]
-    riding = [s for s in steps if {kinds[s["part"]], kinds[s["onto"]]} == {"gear", "shaft"}]
+    # the gears and spacers ride on their shafts (the spacers sit between the gears)
+    riding = [s for s in steps if {kinds[s["part"]], kinds[s["onto"]]} in RIDING]
     riders = {}
     for step in riding:
-        gear, shaft = ((step["part"], step["onto"]) if kinds[step["part"]] == "gear"
+        gear, shaft = ((step["part"], step["onto"]) if kinds[step["part"]] != "shaft"
                        else (step["onto"], step["part"]))
         riders.setdefault(shaft, []).append(gear)
     local = {}
