@@ -30,7 +30,7 @@ from helpers import reference_text
 GLB_ATOL_M = 1e-6
 #: STL coordinates are float32 in mm.
 STL_ATOL_MM = 1e-4
-KINDS = ("gear", "housing", "shaft", "cam", "planter", "blade", "ground")
+KINDS = ("gear", "housing", "shaft", "spacer", "cam", "planter", "blade", "ground")
 #: Materials: one per kind, and the housings' covers their own (see-through) one.
 MATERIALS = KINDS + ("housing-cover",)
 

@@ -195,7 +195,8 @@ def _axial_stack(b, retention, shaft, me, copy, housing_of, parts_of):
 
 
 def _flange_items(flange) -> tuple:
-    return screw_items(flange["bolt"], float(flange["thickness"]), int(flange["bolts"]))
+    return screw_items(flange["bolt"], float(flange["thickness"]), int(flange["bolts"]),
+                       length=flange.get("screw_length"))
 
 
 def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None,

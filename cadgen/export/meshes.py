@@ -91,6 +91,7 @@ PART_MATERIALS = {
     "lever": (0x2F6FA8, 1.0, 0.5),      # the duckbill's lever, push rod and links: steel
     "push-rod": (0x6E747C, 1.0, 0.8),
     "link": (0x4D7FB0, 1.0, 0.5),
+    "spacer": (0xA7ADB5, 1.0, 0.7),     # the turned spacers between the parts on a shaft
     "ground": (0x9B7653, 0.35, 0.0),
     "sprocket": (0x4A4F57, 1.0, 0.6),   # a bought steel chain wheel (its envelope)
     "part": (0x8C8C8C, 1.0, 0.1),   # a part of no known kind

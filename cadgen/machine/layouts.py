@@ -75,26 +75,40 @@ HOLLOW_WALL_MIN = 2.0
 
 def carry_flange(outside: float) -> dict:
     """The bolted flange on a hollow shaft of ``outside`` diameter that carries a housing:
-    ``CARRY_BOLTS`` screws of ``CARRY_BOLT`` on a circle 1.5 bolt diameters outside the shaft."""
+    ``CARRY_BOLTS`` screws of ``CARRY_BOLT`` on a circle 1.5 bolt diameters outside the shaft.
+
+    The screws go in from under the flange and engage 1.5 diameters of the carried floor's
+    tapped holes (at most two diameters deep, :func:`cadgen.solids.fixing_features.floor_holes`):
+    the flange is as thick as the shortest standard ISO 4762 length of at least 3 diameters less
+    that engagement (at least ``CARRY_FLANGE_THICKNESS`` diameters), so the screw's end stops in
+    its hole, not against its bottom."""
+    from cadgen.machine.catalogue import screw_length
+
     bolt = float(CARRY_BOLT.removeprefix("M"))
     circle = outside / 2 + 1.5 * bolt
+    length = screw_length(CARRY_BOLT, (CARRY_FLANGE_THICKNESS + 1.5) * bolt)
     return {"bolt": CARRY_BOLT, "bolts": CARRY_BOLTS, "bolt_circle_radius": circle,
             "radius": circle + CARRY_FLANGE_MARGIN * bolt + bolt / 2,
-            "thickness": CARRY_FLANGE_THICKNESS * bolt}
+            "thickness": length - 1.5 * bolt, "screw_length": length}
 
 
 def planting_bases(cavities, gap: float):
     """``walls -> {housing: z of its cavity floor}`` in gearbox 1's frame: the frame (the
     transmission box) below gearbox 1, the flange of the sleeve that carries gearbox 1 between
-    them; gearbox 2 above, the flange of the hollow shaft C that carries it between them."""
+    them; gearbox 2 above, the flange of the hollow shaft C that carries it between them. Each
+    flange is screwed against the floor it carries; under it the screws' heads turn a gap clear
+    of the roof below."""
+    from cadgen.machine.catalogue import socket_screw
+
     flange = carry_flange(0.0)["thickness"]
+    under = gap + socket_screw(CARRY_BOLT)["head_height"]
 
     def bases(walls):
         out = {"gearbox1": 0.0}
         h1 = cavities["gearbox1"].height
-        out["gearbox2"] = h1 + walls["gearbox1"][1] + gap + flange + gap + walls["gearbox2"][0]
+        out["gearbox2"] = h1 + walls["gearbox1"][1] + under + flange + walls["gearbox2"][0]
         if "frame" in cavities:
-            out["frame"] = -(walls["gearbox1"][0] + gap + flange + gap + walls["frame"][1]
+            out["frame"] = -(walls["gearbox1"][0] + under + flange + walls["frame"][1]
                              + cavities["frame"].height)
         return out
     return bases
