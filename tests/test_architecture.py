@@ -45,7 +45,9 @@ ALLOWED = {
                       "cadgen.solids", "cadgen.machine", "cadgen.assembly"},
     "cadgen.pipeline": {"kinematics", "cadgen.params", "cadgen.params.feasibility",
                         "cadgen.geometry", "cadgen.gears", "cadgen.cam", "cadgen.machine",
-                        "cadgen.solids", "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report"},
+                        "cadgen.solids", "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report",
+                        # the worker beside the teeth: started whole, dying with the build
+                        "cadgen.processes"},
     "cadgen.batch": {"kinematics", "cadgen.params", "cadgen.export", "cadgen.pipeline",
                      "cadgen.processes"},
     # the studio: over the public API, the parameter models (its form's schema, its saves),
@@ -59,7 +61,7 @@ ALLOWED = {
     # definition each: the study is validated as the form is, best.toml written as a save)
     "cadgen.optimize": {"kinematics", "cadgen", "cadgen.params", "cadgen.design", "cadgen.gears",
                         "cadgen.cam", "cadgen.machine", "cadgen.solids", "cadgen.report",
-                        "cadgen.export", "cadgen.studio"},
+                        "cadgen.export", "cadgen.studio", "cadgen.processes"},
     # the command line uses the public API only (and the two helpers it shares with the studio)
     "cadgen.cli": {"cadgen", "cadgen.crash", "cadgen.math_threads", "cadgen.processes"},
     "cadgen.__main__": {"cadgen.cli"},

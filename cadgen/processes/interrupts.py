@@ -1,5 +1,9 @@
 """Ctrl-C that always stops a command: one line, exit 130, nothing half-written.
 
+SIGTERM (a service manager, ``kill``, a CI runner's time limit) and SIGHUP (the terminal
+closed) are taken the same way (:data:`INTERRUPT_SIGNALS`): the command stops as on
+Ctrl-C and exits 128 + the signal's number (143, 129).
+
 Python turns SIGINT into a KeyboardInterrupt raised wherever the main thread happens to be.
 Most of the time that unwinds the command, its staged outputs are removed on the way and
 the command line says ``cadgen: interrupted``. But the interrupt can land where a library
@@ -31,11 +35,15 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["Interrupts", "REPEAT_SECONDS", "EXIT_INTERRUPTED", "sigint_deferred",
-           "release_deferred_sigint"]
+__all__ = ["Interrupts", "REPEAT_SECONDS", "EXIT_INTERRUPTED", "INTERRUPT_SIGNALS",
+           "interrupted_status", "sigint_deferred", "release_deferred_sigint"]
 
 #: Exit status of an interrupted command (128 + SIGINT, the shell's convention).
 EXIT_INTERRUPTED = 128 + signal.SIGINT
+#: The signals that stop a command as Ctrl-C does: SIGINT, SIGTERM and SIGHUP (where the
+#: platform has it). A command exits with :func:`interrupted_status` of the one that came.
+INTERRUPT_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
+                          if hasattr(signal, name))
 #: How often an interrupt that did not stop the command is raised again (s).
 REPEAT_SECONDS = 0.1
 #: How many :func:`sigint_deferred` blocks are open: while one is, the handler only remembers
@@ -68,13 +76,19 @@ class Interrupts:
         Raise only while ``active()`` is true (a batch worker: while it runs a design; an
         idle one only remembers). Default: always, until :attr:`stopping`.
     signals : tuple of int
-        The signals taken as an interrupt (default SIGINT; the studio's build process
-        is stopped by SIGTERM). :attr:`signal` is the one that came.
+        The signals taken as an interrupt (default :data:`INTERRUPT_SIGNALS`; the
+        studio's build process is stopped by SIGTERM only). :attr:`signal` is the first
+        that came.
+    on_signal : callable, optional
+        Called with the signal's number first thing in the handler (in this process, not
+        a forked one): a batch worker ends there when its parent has died and it holds no
+        design (:mod:`cadgen.processes.lifeline`).
     """
 
     def __init__(self, repeat_seconds: float = REPEAT_SECONDS, *, active=None,
-                 signals: tuple = (signal.SIGINT,)):
+                 signals: tuple = INTERRUPT_SIGNALS, on_signal=None):
         self.owner = os.getpid()
+        self._on_signal = on_signal
         self.signals = tuple(signals)
         self.signal: int | None = None
         self.seen = False
@@ -95,6 +109,8 @@ class Interrupts:
     def _handle(self, signum, frame):
         if os.getpid() != self.owner:
             os._exit(128 + signum)   # a forked worker: its parent reports the interrupt
+        if self._on_signal is not None:
+            self._on_signal(signum)
         self.seen = True
         self.signal = self.signal or signum
         self._watch()
@@ -166,6 +182,12 @@ class Interrupts:
         return False
 
 
+def interrupted_status(signum: int | None) -> int:
+    """The exit status of a command stopped by ``signum``: 128 + its number (the shell's
+    convention: 130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP); 130 if unknown."""
+    return 128 + int(signum or signal.SIGINT)
+
+
 def _initialising_extension(frame) -> bool:
     """Whether ``frame`` runs inside the initialisation of a compiled extension module.
 
@@ -202,6 +224,7 @@ def _handling(thread: int) -> BaseException | None:
 def sigint_deferred() -> Iterator[None]:
     """Hold Ctrl-C back in this thread while the block runs: a block that must be done
     whole or not at all (child processes started, a folder made and named, a swap).
+    Every one of :data:`INTERRUPT_SIGNALS` is held back, SIGTERM and SIGHUP as SIGINT.
 
     A child started meanwhile (fork, or fork and exec) inherits the block: a Ctrl-C that
     reaches it before it has installed its handler stays pending until it calls
@@ -214,7 +237,8 @@ def sigint_deferred() -> Iterator[None]:
     """
     blocking = hasattr(signal, "pthread_sigmask")
     main = threading.current_thread() is threading.main_thread()
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocking else None
+    previous = (signal.pthread_sigmask(signal.SIG_BLOCK, set(INTERRUPT_SIGNALS)) if blocking
+                else None)
     if main:   # (a signal another thread takes runs the handler here all the same)
         _DEFERRING[0] += 1
     try:
@@ -230,7 +254,7 @@ def sigint_deferred() -> Iterator[None]:
 
 
 def release_deferred_sigint() -> None:
-    """In a child started under :func:`sigint_deferred`, once its SIGINT handler is in
-    place: unblock SIGINT, so a Ctrl-C that came meanwhile reaches the handler now."""
+    """In a child started under :func:`sigint_deferred`, once its handler is in place:
+    unblock the interrupt signals, so one that came meanwhile reaches the handler now."""
     if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(INTERRUPT_SIGNALS))
