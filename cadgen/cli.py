@@ -15,7 +15,10 @@ Exit codes (every command):
   (``cadgen: internal error: ...``) with the path of a file holding the traceback, the
   versions and the command line (in ``$CADGEN_CRASH_DIR``, else the temporary directory);
 - 130 (:data:`EXIT_INTERRUPTED`): interrupted (Ctrl-C): one line, ``cadgen:
-  interrupted``; outputs are staged, so no half-written folder is left;
+  interrupted``; outputs are staged, so no half-written folder is left; SIGTERM and
+  SIGHUP stop a command the same way, with 143 and 129 (128 + the signal's number) and
+  the line ``cadgen: terminated by SIGTERM`` (``SIGHUP``). Every process the command
+  started ends with it, however it ends (:mod:`cadgen.processes.lifeline`);
 - 141 (:data:`EXIT_BROKEN_PIPE`): the reader of the output went away (``| head``), quietly.
 
 Every error is one line on stderr, never a traceback. numpy, scipy, matplotlib and
@@ -33,7 +36,9 @@ from pathlib import Path
 # the one-line report and crash file of a bug, shared with the studio's server and builds
 from cadgen.crash import CRASH_DIR_VARIABLE, one_line as _one_line
 from cadgen.crash import write_crash_file as _write_crash_file
+from cadgen.processes import INTERRUPT_SIGNALS as _INTERRUPT_SIGNALS
 from cadgen.processes import Interrupts as _Interrupts
+from cadgen.processes import interrupted_status as _interrupted_status
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_CHECKS_FAILED", "EXIT_PROBLEMS",
            "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE", "CRASH_DIR_VARIABLE"]
@@ -47,6 +52,9 @@ EXIT_INTERNAL = 3
 EXIT_INTERRUPTED = 130
 #: The reader of the output went away (128 + SIGPIPE, the shell's convention).
 EXIT_BROKEN_PIPE = 141
+#: Seconds an interrupted command's exit waits for its threads (a process pool's manager
+#: thread) before it ends without them (see :func:`entry`).
+INTERRUPTED_EXIT_SECONDS = 1.0
 
 
 def _version() -> str:
@@ -464,6 +472,17 @@ def entry() -> None:
     status = main()
     processes = sys.modules.get("multiprocessing")   # never imported: no child to wait for
     shutdown = getattr(threading, "_shutdown", None)
+    if status in _STOPPED_STATUSES:
+        # Stopped: the command's own cleanup is done (main() returned: no staging folder is
+        # left), and what it started is abandoned (it would die with it anyway, see
+        # cadgen.processes.lifeline). A thread that does not end is not waited for: a
+        # process pool's manager thread reading a result its worker was killed in the
+        # middle of sending waits for the rest for ever, and so would the interpreter's
+        # exit, which joins it.
+        for child in processes.active_children() if processes is not None else ():
+            child.kill()
+        if not _threads_ended(INTERRUPTED_EXIT_SECONDS):
+            _flush_and_exit(status)
     if (processes is not None and processes.active_children()) or shutdown is None:
         raise SystemExit(status)
     # What the interpreter's exit does first: wait for every non-daemon thread to end, to
@@ -473,6 +492,28 @@ def entry() -> None:
     # the exit handlers threads registered (concurrent.futures' joins its pools' threads)
     shutdown()
     atexit._run_exitfuncs()
+    _flush_and_exit(status)
+
+
+#: The exit statuses of a command stopped by a signal (130, 143, 129).
+_STOPPED_STATUSES = frozenset(_interrupted_status(signum) for signum in _INTERRUPT_SIGNALS)
+
+
+def _threads_ended(seconds: float) -> bool:
+    """Wait up to ``seconds`` for every other non-daemon thread to end; have they?"""
+    import threading
+    import time
+
+    deadline = time.monotonic() + seconds
+    for thread in threading.enumerate():
+        if thread is not threading.current_thread() and not thread.daemon:
+            thread.join(max(0.0, deadline - time.monotonic()))
+            if thread.is_alive():
+                return False
+    return True
+
+
+def _flush_and_exit(status: int) -> None:
     try:
         sys.stdout.flush()
         sys.stderr.flush()
@@ -494,8 +535,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     int
         The exit status: ``EXIT_OK``, ``EXIT_CHECKS_FAILED``, ``EXIT_PROBLEMS``,
         ``EXIT_INTERNAL`` (an unexpected exception, saved to a crash file) or
-        ``EXIT_INTERRUPTED`` (Ctrl-C). argparse's own exits (``--help``, a bad
-        command line) raise SystemExit as usual.
+        ``EXIT_INTERRUPTED`` (Ctrl-C; 143 for SIGTERM, 129 for SIGHUP). argparse's own
+        exits (``--help``, a bad command line) raise SystemExit as usual.
     """
     argv = list(sys.argv[1:] if argv is None else argv)
     from cadgen.math_threads import one_thread_for_commands
@@ -530,6 +571,19 @@ def main(argv: Sequence[str] | None = None) -> int:
                     return EXIT_PROBLEMS
                 return _internal_error(error, argv)
         if interrupts.seen:
-            print("cadgen: interrupted", file=sys.stderr)
-            return EXIT_INTERRUPTED
+            return _stopped(interrupts.signal)
         return status
+
+
+def _stopped(signum: int | None) -> int:
+    """Say on one line that a signal stopped the command; its exit status (128 + its number)."""
+    import signal
+
+    signum = signum or signal.SIGINT
+    line = ("cadgen: interrupted" if signum == signal.SIGINT
+            else f"cadgen: terminated by {signal.Signals(signum).name}")
+    try:
+        print(line, file=sys.stderr)
+    except (OSError, ValueError):   # the terminal is gone (SIGHUP): nowhere to say it
+        pass
+    return _interrupted_status(signum)

@@ -57,10 +57,21 @@ class _Beside:
     def finish(self, pairs: dict | None = None):
         """Send the last task (the pairs' figures to draw, or none): it closes the worker's
         progress pipe, and the worker ends after it."""
+        from cadgen.processes import sigint_deferred
+
         if self.pairs is None:
-            self.pairs = self.executor.submit(_beside_pairs, pairs or {})
+            with sigint_deferred():   # the task queued whole (see start_beside)
+                self.pairs = self.executor.submit(_beside_pairs, pairs or {})
             self.executor.shutdown(wait=False)
         return self.pairs
+
+    def stop(self) -> None:
+        """Abandon the worker (the build was interrupted, or failed): kill it now, rather
+        than let it finish its tasks while the interrupted build ends, or hold up the
+        process's exit (whose pool thread waits for them)."""
+        from cadgen.processes import stop_pool
+
+        stop_pool(self.executor)
 
     def done(self) -> bool:
         return self.pairs is not None and self.pairs.done()
@@ -92,7 +103,7 @@ def start_beside(run, functions):
             or run.parallel is False or not _can_fork() \
             or any(r.status != "ok" for r in run.records):
         return None
-    from concurrent.futures import ProcessPoolExecutor
+    from cadgen.processes import process_pool, sigint_deferred
 
     # what both processes need, imported once before the fork: this process needs it anyway
     # (its parts, its gear figures), so only the worker's time is saved
@@ -109,17 +120,24 @@ def start_beside(run, functions):
     taken, pool, pool_key = context.Value("i", 0), context.Value("i", 0), context.Value("q", -1)
     _BESIDE.update(run=run, functions=functions, sweeps=sweeps, figures=figures, parts=parts,
                    events=ends[1] if ends else None, taken=taken, pool=pool, pool_key=pool_key)
-    executor = ProcessPoolExecutor(1, mp_context=context)
     try:
-        meshes = executor.submit(_beside_parts)     # forks the worker here
-        solids = executor.submit(_beside_sweeps)    # the same worker, tasks in order
-        figures = executor.submit(_beside_figures)
+        # started and queued whole, interrupts held back: a worker started but not yet known
+        # to its pool (or a task half queued) left the pool's thread waiting for ever, and
+        # the process's exit with it; the worker dies with this thread (see process_pool)
+        with sigint_deferred():
+            executor = process_pool(1, context)
+            meshes = executor.submit(_beside_parts)     # forks the worker here
+            solids = executor.submit(_beside_sweeps)    # the same worker, tasks in order
+            figures = executor.submit(_beside_figures)
+            # the run holds it from here: stopped if the build is interrupted (Run.run)
+            run._beside = _Beside(executor, meshes, solids, figures, sweeps, taken, pool,
+                                  pool_key)
     finally:
         _BESIDE.clear()             # the forked worker has its own copy
         if ends:
             run.progress.relay(ends[0])
             ends[1].close()         # the worker's copy is the last: its end is the relay's
-    return _Beside(executor, meshes, solids, figures, sweeps, taken, pool, pool_key)
+    return run._beside
 
 
 def _beside_parts() -> dict:

@@ -125,6 +125,7 @@ class _Build:
         self.effects: tuple = ()       # the scene's (set by :func:`build`)
         self.case = "field"
         self.parallel: bool | None = None   # False: no worker forked (see :func:`build`)
+        self._beside = None            # the forked worker until collected (see run)
 
     @property
     def soil(self) -> bool:
@@ -136,12 +137,30 @@ class _Build:
         return next((r.status for r in self.records if r.stage == stage), "not run")
 
     def run(self, functions: dict) -> None:
-        beside = None      # the forked worker's future (see _start_beside)
+        try:
+            beside = self._run_stages(functions)
+            if beside is not None:
+                from cadgen.pipeline.beside import collect
+
+                collect(self, beside)
+        except BaseException:
+            # interrupted (or a bug): the worker's tasks are abandoned, and it must not run on
+            # while this process ends, nor hold up that end (see _Beside.stop)
+            if self._beside is not None:
+                self._beside.stop()
+            raise
+        finally:
+            self._beside = None
+        self.records.sort(key=lambda record: STAGE_ORDER.index(record.stage))
+
+    def _run_stages(self, functions: dict):
+        """Run the stages in order; the forked worker if its results are still to collect."""
+        beside = None
         for stage in self.stages:
             if stage == "teeth" and beside is None:
                 from cadgen.pipeline.beside import start_beside
 
-                beside = start_beside(self, functions)
+                beside = start_beside(self, functions)   # (sets self._beside)
             if beside is not None and stage in beside.sweeps:
                 continue            # the worker's: collected with its figures (_collect)
             failed = [need for need in STAGE_NEEDS[stage]
@@ -156,7 +175,7 @@ class _Build:
                 from cadgen.pipeline.beside import plots_beside
 
                 record, value = plots_beside(self, beside)
-                beside = None
+                beside = self._beside = None     # collected
             else:
                 self.progress.started(stage)
                 record, value = _run_stage(self, stage, functions)
@@ -165,11 +184,7 @@ class _Build:
             self.records.append(record)
             if record.status == "ok":
                 self.values[stage] = value
-        if beside is not None:
-            from cadgen.pipeline.beside import collect
-
-            collect(self, beside)
-        self.records.sort(key=lambda record: STAGE_ORDER.index(record.stage))
+        return beside
 
 
 def _run_stage(run, stage: str, functions: dict):

@@ -121,7 +121,7 @@ def preload() -> None:
 def _draw_in_two(jobs: dict, progress=None) -> dict:
     """Draw ``jobs`` in this process and a forked worker, each taking the next figure not yet
     taken (a shared counter), so that neither waits for the other however the costs fall."""
-    from concurrent.futures import ProcessPoolExecutor
+    from cadgen.processes import process_pool, sigint_deferred, stop_pool
 
     preload()                                   # once, before the fork, for both
     context = multiprocessing.get_context("fork")
@@ -130,16 +130,23 @@ def _draw_in_two(jobs: dict, progress=None) -> dict:
     _WORKER.clear()
     _WORKER.update(jobs=jobs, names=names, taken=context.Value("i", 0), progress=progress,
                    events=ends[1] if ends else None)
+    pool = None
     try:
-        with ProcessPoolExecutor(1, mp_context=context) as pool:
+        # started whole, the worker dying with this thread (see cadgen.processes.lifeline)
+        with sigint_deferred():
+            pool = process_pool(1, context)
             future = pool.submit(_draw_worker_jobs)   # forks the worker here
-            if ends:
-                progress.relay(ends[0])
-                ends[1].close()
-            figures = _draw_untaken(progress)
-            figures.update(future.result())
+        if ends:
+            progress.relay(ends[0])
+            ends[1].close()
+        figures = _draw_untaken(progress)
+        figures.update(future.result())
+        pool.shutdown()
         if progress is not None:
             progress.join()
+    except BaseException:
+        stop_pool(pool)     # interrupted: the worker's figures are not waited for
+        raise
     finally:
         _WORKER.clear()
     return figures
