@@ -6,6 +6,8 @@ process. From a single-threaded process (a local worker) the child is forked; el
 it is a new interpreter. The child leads its own process group and watches a pipe from
 its job; its job waits for it with the time limit, then SIGKILLs the group (the child
 and every worker its build forked) and removes the staging folders a killed build left.
+At the pipe's end (the job's process died) the child kills its group itself
+(:func:`cadgen.processes.watch_lifeline`).
 """
 
 from __future__ import annotations
@@ -27,10 +29,9 @@ from typing import Any
 from cadgen.batch.grid import DesignJob
 from cadgen.batch.single import (Build, _exception_failure, _is_default_build, _resolve_build,
                                  _summary, run_design)
+from cadgen.processes import EXIT_ORPHANED, watch_lifeline
 
 __all__ = ["run_design_isolated"]
-
-_ORPHANED = 70  # exit code of a design's process whose job went away (see _watch_lifeline)
 
 
 #: What cadgen.export.atomic.staged_directory leaves beside ``<name>`` if its process is killed:
@@ -74,29 +75,24 @@ def _put_result(path: str, outcome: tuple) -> None:
     os.replace(path + ".tmp", path)
 
 
-def _watch_lifeline(fd: int) -> None:
-    """Block on the lifeline pipe; at its end (the job is gone) kill this process's group.
+def _job_gone() -> None:
+    """At the lifeline's end (the job is gone): kill this process's group.
 
-    Only the job holds the pipe's write end and it never writes, so the read returns at
-    end-of-file: when the job closes it after this process ended, or when the job's own
-    process dies (a killed local worker, a Dask worker restarted). Then the design's
-    process and the workers its build forked must not run on unwatched.
+    Only the job holds the pipe's write end and it never writes, so its end comes when
+    the job closes it after this process ended, or when the job's own process dies (a
+    killed local worker, a Dask worker restarted). Then the design's process and the
+    workers its build forked must not run on unwatched. (A local worker that dies with
+    the batch's process first stops its design and removes its staging folder.)
     """
-    try:
-        while os.read(fd, 512):
-            pass
-    except OSError:
-        pass
     if hasattr(os, "killpg") and os.getpgrp() == os.getpid():
         os.killpg(os.getpid(), signal.SIGKILL)
-    os._exit(_ORPHANED)
+    os._exit(EXIT_ORPHANED)
 
 
 def _child_setup(lifeline: int) -> None:
     """First thing in a design's process: its own process group, a lifeline watcher, and
     Python tracebacks on a segfault (to stderr)."""
     import faulthandler
-    import threading
     import warnings
 
     if hasattr(os, "setsid"):
@@ -106,8 +102,7 @@ def _child_setup(lifeline: int) -> None:
     # The build forks its own workers with the watcher thread present: it holds no lock
     # (it waits in os.read), so the forked worker is safe; Python 3.12 would warn anyway.
     warnings.filterwarnings("ignore", r".*multi-threaded, use of fork\(\)", DeprecationWarning)
-    threading.Thread(target=_watch_lifeline, args=(lifeline,), name="cadgen-lifeline",
-                     daemon=True).start()
+    watch_lifeline(lifeline, _job_gone)
 
 
 def _in_child(job, output_root, build, build_kwargs, result_path) -> None:

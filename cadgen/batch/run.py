@@ -22,9 +22,11 @@ __all__ = ["run_batch"]
 
 
 #: A local worker's state (see :func:`_worker_start`): its interrupt handler, whether it runs a
-#: design, and the queue on which it says which design it starts (read by the batch's
-#: process, see :func:`_run_local`).
-_WORKER = {"interrupts": None, "busy": False, "starts": None}
+#: design, the queue on which it says which design it starts (read by the batch's
+#: process, see :func:`_run_local`), the batch's process (its parent) and whether that
+#: has died.
+_WORKER = {"interrupts": None, "busy": False, "starts": None, "parent": None,
+           "orphaned": False}
 #: Seconds between looks at the local workers' starts while waiting for results.
 _START_POLL_SECONDS = 0.1
 #: What a worker tells on the starts queue, instead of a design's number, once its handler
@@ -32,7 +34,7 @@ _START_POLL_SECONDS = 0.1
 _READY = -1
 
 
-def _worker_start(starts=None) -> None:
+def _worker_start(starts=None, parent: int | None = None) -> None:
     """Initializer of a local worker: Ctrl-C stops its design, cleanly, without a traceback.
 
     The terminal sends SIGINT to the whole process group, the workers included, and the
@@ -45,15 +47,38 @@ def _worker_start(starts=None) -> None:
     the worker ends quietly. The batch's own process reports the interrupt once. The
     worker was started with SIGINT blocked (:func:`cadgen.processes.sigint_deferred`): a
     Ctrl-C that came while it was still importing waits for this handler, and is handled
-    as soon as it is unblocked here.
+    as soon as it is unblocked here. SIGTERM and SIGHUP are taken as SIGINT.
+
+    The worker dies with the batch's process ``parent``: it is sent SIGTERM when that
+    ends, however (:func:`cadgen.processes.process_pool`), and then ends at once if idle;
+    if busy, it stops its design as on Ctrl-C (its process group killed, its staging
+    folder removed) and then ends (:func:`_orphan_check`).
     """
     from cadgen.processes import Interrupts, release_deferred_sigint
 
     _WORKER["starts"] = starts
-    _WORKER["interrupts"] = Interrupts(active=lambda: _WORKER["busy"]).install()
+    _WORKER["parent"] = parent
+    _WORKER["interrupts"] = Interrupts(active=lambda: _WORKER["busy"],
+                                       on_signal=_orphan_check).install()
     release_deferred_sigint()
     if starts is not None:   # (after the release: an interrupt that came is taken by now)
         starts.put((os.getpid(), _READY))
+
+
+def _orphan_check(signum: int) -> None:
+    """In a worker's interrupt handler: has the batch's process died (the signal is its
+    parent-death signal, or came after)? Then an idle worker ends now; a busy one is
+    interrupted (its design stopped and cleaned up), ends after (:func:`_run_job`), and is
+    killed if that takes longer than :data:`cadgen.processes.ORPHAN_GRACE_SECONDS`."""
+    from cadgen.processes import EXIT_ORPHANED, end_after, orphaned
+
+    parent = _WORKER["parent"]
+    if parent is None or not orphaned(parent) or _WORKER["orphaned"]:
+        return
+    if not _WORKER["busy"]:
+        os._exit(EXIT_ORPHANED)
+    _WORKER["orphaned"] = True
+    end_after()
 
 
 def _interrupted() -> bool:
@@ -74,6 +99,10 @@ def _run_job(job, output_root, build, build_kwargs, timeout, isolate, number=Non
         return run_design(job, output_root, build, build_kwargs)
     finally:
         _WORKER["busy"] = False
+        if _WORKER["orphaned"]:   # its design stopped and cleaned: nobody waits for more
+            from cadgen.processes import EXIT_ORPHANED
+
+            os._exit(EXIT_ORPHANED)
 
 
 # --------------------------------------------------------------------------- executors
@@ -152,7 +181,9 @@ def _drain(starts, ready: set) -> list[tuple[int, int]]:
 
 def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    import signal
+
+    from cadgen.processes import process_pool
 
     # spawn: one start method on every platform, safe when the parent holds threads (a
     # Dask client); each worker pays its imports once and forks each design from there.
@@ -171,9 +202,11 @@ def _run_local(jobs, output_root, task, workers, on_result, on_start=None):
         # delivered as the block ends
         with sigint_deferred():
             starts = context.SimpleQueue()
-            pool = ProcessPoolExecutor(max_workers=max(1, min(workers, len(jobs))),
-                                       mp_context=context, initializer=_worker_start,
-                                       initargs=(starts,))
+            # each worker dies with this process (SIGTERM: it stops its design and removes
+            # its staging folder first, see _worker_start)
+            pool = process_pool(max(1, min(workers, len(jobs))), context,
+                                initializer=_worker_start, initargs=(starts, os.getpid()),
+                                death_signal=signal.SIGTERM)
             for number, job in enumerate(jobs):
                 submitted.append(pool.submit(_run_job, job, output_root, *task, number=number))
                 futures[submitted[-1]] = job

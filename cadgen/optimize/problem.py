@@ -237,13 +237,20 @@ class PopulationEvaluator:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc_info):
-        self.close()
+    def __exit__(self, exc_type, *exc_info):
+        self.close(abandon=exc_type is not None)
         return False
 
-    def close(self) -> None:
+    def close(self, abandon: bool = False) -> None:
+        """End the pool (and the Dask client); ``abandon``: kill its workers at once rather
+        than wait for the chunks they are evaluating (the run was interrupted, or failed)."""
         if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
+            if abandon:
+                from cadgen.processes import stop_pool
+
+                stop_pool(self._pool)
+            else:
+                self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
         if self._client is not None:
             self._client.close()
@@ -265,13 +272,25 @@ class PopulationEvaluator:
     def _local_pool(self):
         if self._pool is None:
             import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
 
+            from cadgen.processes import process_pool
+
+            # its workers die with this thread, whatever ends it (cadgen.processes.lifeline)
             method = "fork" if "fork" in multiprocessing.get_all_start_methods() else None
-            self._pool = ProcessPoolExecutor(
-                max_workers=self.workers, mp_context=multiprocessing.get_context(method),
-                initializer=_set_worker_problem, initargs=(self.problem,))
+            self._pool = process_pool(self.workers, multiprocessing.get_context(method),
+                                      initializer=_set_worker_problem,
+                                      initargs=(self.problem,))
         return self._pool
+
+    def _pool_map(self, function, items) -> list:
+        """``function`` of each item over the local pool, in order. The tasks are queued
+        (and the workers started) whole, interrupts held back: see
+        :func:`cadgen.processes.process_pool`."""
+        from cadgen.processes import sigint_deferred
+
+        with sigint_deferred():
+            results = self._local_pool().map(function, items)
+        return list(results)
 
     def _dask(self):
         if self._client is None:
@@ -305,8 +324,7 @@ class PopulationEvaluator:
                        for a, b in bounds]
             parts = client.gather(futures)   # in the order submitted
         else:
-            pool = self._local_pool()
-            parts = list(pool.map(_evaluate_in_worker, [X[a:b] for a, b in bounds]))
+            parts = self._pool_map(_evaluate_in_worker, [X[a:b] for a, b in bounds])
         return _merge(parts, count)
 
     def check(self, designs) -> list[dict]:
@@ -321,7 +339,7 @@ class PopulationEvaluator:
             client = self._dask()
             return client.gather([client.submit(with_problem, self._remote_problem, x,
                                                 pure=False) for x in designs])
-        return list(self._local_pool().map(in_worker, designs))
+        return self._pool_map(in_worker, designs)
 
     def certify(self, designs) -> list[dict]:
         """:func:`certify_design` of each design (n,), in order, where populations are evaluated."""

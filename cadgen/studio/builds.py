@@ -22,7 +22,14 @@ child would be copied, perhaps holding its lock, into the workers the build fork
 The child of the next build is started, and imports what a build will (scipy, trimesh,
 matplotlib...: :func:`cadgen.pipeline.warm.warm_all`), as soon as a build ends: it then waits
 for its design on stdin, so the designer's next build does not pay the interpreter's start
-and those imports (about half its time). It ends with the server: its stdin closes.
+and those imports (about half its time).
+
+Every child ends with the server, however the server ends (killed too): it watches a
+lifeline pipe whose write end only the server holds (:mod:`cadgen.processes.lifeline`; a
+pipe rather than a parent-death signal, which would come when the request thread that
+started the child ends). At its end a waiting child ends at once, and a building one stops
+as on the server's SIGTERM (its staging folder removed), killed with its workers if that
+takes longer than :data:`cadgen.processes.ORPHAN_GRACE_SECONDS`.
 
 In the server, a thread per job reads the pipe into the job's event list;
 :meth:`BuildJobs.events` replays that list to any subscriber, late ones included, and
@@ -185,6 +192,7 @@ class BuildJobs:
         if spare[0].poll() is None:
             return spare
         spare[1].close()
+        _let_go(spare[0])
         return None
 
     def _start_spare(self) -> None:
@@ -207,6 +215,7 @@ class BuildJobs:
             return
         process, receiving = spare
         _close_stdin(process)       # its design will not come: it ends
+        _let_go(process)            # (so does its lifeline)
         try:
             process.wait(STOP_GRACE_SECONDS)
         except subprocess.TimeoutExpired:
@@ -242,6 +251,7 @@ class BuildJobs:
         except subprocess.TimeoutExpired:   # said done but does not end (a worker it awaits)
             _signal_group(process.pid, signal.SIGKILL)
             process.wait()
+        _let_go(process)
         if job.done is None:
             job.add(_done(EXIT_STOPPED if job.stopping else EXIT_INTERNAL,
                           error=_death(process.returncode, job.stopping)))
@@ -314,6 +324,9 @@ def _start_child(warm: bool = False):
     import cadgen
 
     reading, writing = os.pipe()
+    # the child's lifeline (see the module docstring): the server keeps the write end
+    # (close-on-exec: no other child inherits it), the child reads the other
+    alive, lifeline = os.pipe()
     environment = dict(os.environ)
     # the cadgen this server runs, even from a source tree that was never installed
     source = str(Path(cadgen.__file__).resolve().parents[1])
@@ -321,19 +334,30 @@ def _start_child(warm: bool = False):
         [source, *filter(None, [environment.get("PYTHONPATH")])])
     try:
         process = subprocess.Popen(
-            [sys.executable, "-m", "cadgen.studio.builds", str(writing),
+            [sys.executable, "-m", "cadgen.studio.builds", str(writing), str(alive),
              *(["--warm"] if warm else [])],
-            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, pass_fds=(writing,),
+            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, pass_fds=(writing, alive),
             env=environment,
             # a group of its own: shutdown() signals it and the workers the build forks,
             # and the terminal's Ctrl-C reaches the server only, which stops it
             process_group=0)
     except BaseException:
         os.close(reading)
+        os.close(lifeline)
         raise
     finally:
         os.close(writing)   # the child's copy is the last: its death closes the pipe
+        os.close(alive)
+    process.lifeline = lifeline
     return process, Connection(reading, writable=False)
+
+
+def _let_go(process) -> None:
+    """Close the server's end of the child's lifeline (the child has ended, or is told to)."""
+    lifeline, process.lifeline = getattr(process, "lifeline", None), None
+    if lifeline is not None:
+        with contextlib.suppress(OSError):
+            os.close(lifeline)
 
 
 def _send_request(process, params: dict, output_root: Path) -> None:
@@ -380,12 +404,32 @@ def _done(exit_code: int, *, report=None, glb=None, summary: str = "", error=Non
 
 
 # --------------------------------------------------------------------------- the child
+#: In the child: whether it builds (see :func:`_server_gone`).
+_CHILD = {"building": False}
+
+
+def _server_gone() -> None:
+    """In the child, at the lifeline's end (the server has ended, however): a child that
+    waits for its design ends now; a building one stops as on the server's SIGTERM (its
+    staging folder removed), killed with its workers if that takes too long."""
+    from cadgen.processes import EXIT_ORPHANED, end_after
+
+    if not _CHILD["building"]:
+        os._exit(EXIT_ORPHANED)
+    end_after()
+    os.kill(os.getpid(), signal.SIGTERM)
+
+
 def _child_main(arguments: list) -> None:
-    """``python -m cadgen.studio.builds FD``: the design on stdin, events down the pipe FD."""
+    """``python -m cadgen.studio.builds FD LIFELINE``: the design on stdin, events down the
+    pipe FD; ends with the server (the lifeline's end)."""
     from multiprocessing.connection import Connection
 
+    from cadgen.processes import watch_lifeline
+
+    watch_lifeline(int(arguments[1]), _server_gone)
     sending = Connection(int(arguments[0]), readable=False)
-    if "--warm" in arguments[1:]:
+    if "--warm" in arguments[2:]:
         with contextlib.suppress(Exception):   # a build that needs a broken one says so
             from cadgen.pipeline.warm import warm_all
 
@@ -406,6 +450,7 @@ def _child_build(params: dict, output_root: str, sending) -> None:
     # build worker forked from here ends quietly); SIGINT is the server's to decide
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     interrupts = Interrupts(signals=(signal.SIGTERM,)).install()
+    _CHILD["building"] = True   # the server's end now stops the build (_server_gone)
     start = time.perf_counter()
     try:
         try:
@@ -419,6 +464,13 @@ def _child_build(params: dict, output_root: str, sending) -> None:
     done["elapsed_s"] = round(time.perf_counter() - start, 3)
     _send(sending, done)
     sending.close()
+    if done["exit_code"] == EXIT_STOPPED:
+        # stopped: its outputs are cleaned up and its answer sent; the interpreter's exit
+        # is not waited for (it joins the build's pool thread, which may wait for ever on
+        # a result its worker, stopped with it, had half sent)
+        with contextlib.suppress(OSError, ValueError):
+            sys.stderr.flush()
+        os._exit(EXIT_STOPPED)
 
 
 def _send(sending, message: dict) -> None:

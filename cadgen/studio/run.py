@@ -8,6 +8,8 @@ other command pays for them.
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import socket
 import threading
 import time
@@ -101,6 +103,23 @@ def _server_class(uvicorn):
     uvicorn waits for open requests before the app's own shutdown would stop it."""
 
     class StudioServer(uvicorn.Server):
+        @contextlib.contextmanager
+        def capture_signals(self):
+            """uvicorn's (SIGINT, SIGTERM: a clean shutdown, then the signal raised again),
+            and SIGHUP too (the terminal closed), unless it is ignored (``nohup``)."""
+            with super().capture_signals():
+                hangup = getattr(signal, "SIGHUP", None)
+                if hangup is None or threading.current_thread() is not threading.main_thread() \
+                        or signal.getsignal(hangup) is signal.SIG_IGN:
+                    yield
+                    return
+                # put back before uvicorn raises the signals it caught, as it leaves
+                previous = signal.signal(hangup, self.handle_exit)
+                try:
+                    yield
+                finally:
+                    signal.signal(hangup, previous)
+
         async def shutdown(self, sockets=None):
             import asyncio
 
