@@ -39,6 +39,9 @@ renamed into place at the end), so a failed or killed design leaves ``<name>/`` 
 was, a previous build's folder included; after a kill or a death its job removes the
 staging folders the build left (and puts back a previous folder set aside for the swap),
 and :func:`run_batch` sweeps once more for the batch's design names when all are done.
+The local workers die with the batch's process, however it ends (killed too): each is
+sent SIGTERM as it dies (:func:`cadgen.processes.process_pool`), stops its design as on
+Ctrl-C (its group killed, its staging folder removed) and ends.
 One window is left: a design killed in the instant after its new folder was renamed in
 and before its process reported is reported ``timeout`` with its new outputs complete in
 place.

@@ -101,13 +101,36 @@ def orphaned(parent: int) -> bool:
 
 
 def _start_worker(parent: int, signum: int, initializer, initargs: tuple) -> None:
-    """A pool worker's initializer: die with the parent, then the pool's own initializer,
-    then take the interrupts held back while it was started (see :func:`process_pool`)."""
+    """A pool worker's initializer: die with the parent, then the pool's own initializer
+    (imported only now when given as ``"module:name"``), then take the interrupts held back
+    while it was started (see :func:`process_pool`)."""
     from cadgen.processes.interrupts import release_deferred_sigint
 
+    came: list = []
+
+    def starting(number, frame):
+        if orphaned(parent):
+            os._exit(EXIT_ORPHANED)
+        came.append(number)
+
+    if signum != signal.SIGKILL:
+        # until the initializer has put its own handler in place (a batch worker's imports
+        # take seconds on a busy core): the parent's death ends the worker at once (it holds
+        # nothing yet); a signal meant for it is passed on to that handler after
+        previous = signal.signal(signum, starting)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signum})
     die_with_parent(parent, signum)
+    if isinstance(initializer, str):
+        import importlib
+
+        module, _, name = initializer.partition(":")
+        initializer = getattr(importlib.import_module(module), name)
     if initializer is not None:
         initializer(*initargs)
+    if signum != signal.SIGKILL and signal.getsignal(signum) is starting:
+        signal.signal(signum, previous)
+    for number in came:
+        os.kill(os.getpid(), number)
     release_deferred_sigint()
 
 
@@ -129,13 +152,20 @@ def process_pool(workers: int, context, *, initializer=None, initargs: tuple = (
     context : multiprocessing context
         ``fork`` or ``spawn``.
     initializer, initargs
-        As for the executor (a spawned worker needs them picklable).
+        As for the executor (a spawned worker needs them picklable; a module-level
+        initializer is sent by name, imported once the worker dies with this thread).
     death_signal : int
         See :func:`die_with_parent`.
     """
     from concurrent.futures import ProcessPoolExecutor
 
     _prctl()   # looked up here, before any fork
+    if initializer is not None and context.get_start_method() != "fork" \
+            and "." not in initializer.__qualname__:
+        # a new interpreter unpickles the initializer before running any of it: by name, its
+        # module (a batch worker's imports the parameter schema, seconds on a busy core) is
+        # imported after the worker has asked to die with this thread, not before
+        initializer = f"{initializer.__module__}:{initializer.__qualname__}"
     return ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                initializer=_start_worker,
                                initargs=(os.getpid(), int(death_signal), initializer,
