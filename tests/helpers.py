@@ -1,4 +1,5 @@
-"""Small helpers shared by tests: edited copies of the reference parameter file, an FCL model."""
+"""Small helpers shared by tests: edited copies of the reference parameter file, an FCL model,
+a build started through the studio, the processes a command left (from /proc)."""
 
 import re
 from pathlib import Path
@@ -69,3 +70,57 @@ def gears_in_their_housings(assembly, housings, phi: float):
                     if h.z_cavity_bottom <= middle <= h.z_cavity_bottom + h.cavity_height)
         yield part, name, boxes[name], np.linalg.solve(
             assembly.body_pose(bodies[name], phi + first[2]), pose)
+
+
+def start_studio_build(url: str, moment: str | None, *, timeout: float,
+                       effects: list | None = None) -> None:
+    """Start a build through the studio at ``url`` (its URL with the token), of the design it
+    opened (with the scene's ``effects`` if given); return once the build's events reach
+    stage ``moment`` (``"done"``: its end; None: at once). AssertionError if the build ends
+    before."""
+    import json
+    import urllib.request
+
+    base, token = url.split("/?token=")
+    headers = {"X-Cadgen-Token": token, "Content-Type": "application/json"}
+
+    def call(path, body=None):
+        request = urllib.request.Request(base + path, headers=headers, data=body,
+                                         method="POST" if body else "GET")
+        return urllib.request.urlopen(request, timeout=timeout)
+
+    params = json.loads(call("/api/design").read())["params"]
+    if effects is not None:
+        params.setdefault("scene", {})["effects"] = list(effects)
+    job = json.loads(call("/api/build", json.dumps({"params": params}).encode()).read())
+    if moment is None:
+        return
+    for line in call(job["events"]):   # server-sent events: "data: {...}"
+        event = json.loads(line[5:]) if line.startswith(b"data:") else {}
+        if event.get("stage") == moment or event.get("type") == moment:
+            return
+    raise AssertionError(f"the build ended before {moment}")
+
+
+#: The environment variable whose value tags the processes of one command a test starts:
+#: every process it starts inherits it, whatever becomes of its parent.
+TAG_VARIABLE = "CADGEN_TEST_TAG"
+
+
+def tagged_processes(tag: str) -> list[str]:
+    """The processes alive (zombies are dead) whose environment has :data:`TAG_VARIABLE`
+    set to ``tag``, read from /proc (``"pid (name)"`` each)."""
+    needle = f"{TAG_VARIABLE}={tag}".encode() + b"\0"
+    alive = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            if needle not in (entry / "environ").read_bytes():
+                continue
+            stat = (entry / "stat").read_text()
+        except OSError:   # ended meanwhile, or not ours to read
+            continue
+        if stat[stat.rindex(")") + 2] != "Z":
+            alive.append(stat[:stat.rindex(")") + 1])
+    return alive

@@ -23,8 +23,9 @@ from pathlib import Path
 
 import pytest
 
-from cadgen.processes import Interrupts, release_deferred_sigint, sigint_deferred
-from tests.helpers import reference_text, with_keys
+from cadgen.processes import Interrupts, die_with_parent, release_deferred_sigint, sigint_deferred
+from cadgen.processes.lifeline import _prctl
+from tests.helpers import reference_text, start_studio_build, with_keys
 
 ROOT = Path(__file__).resolve().parents[1]
 CADGEN = Path(sys.executable).with_name("cadgen")
@@ -46,8 +47,13 @@ def sigint_as_in_a_terminal():
 
 
 def _foreground():
-    """A child's SIGINT as a terminal's foreground job has it: handled (not ignored)."""
+    """A child's SIGINT as a terminal's foreground job has it: handled (not ignored); and
+    the child stops (SIGTERM, taken as Ctrl-C) if the test's process dies first."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    die_with_parent(os.getppid(), signal.SIGTERM)
+
+
+_prctl()   # looked up here, before any fork (see cadgen.processes.lifeline)
 
 
 # ----------------------------------------------------------------------------- units
@@ -128,9 +134,12 @@ def test_a_child_started_while_sigint_is_deferred_holds_it_until_released():
         child = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
                                  preexec_fn=_foreground,
                                  stdout=subprocess.PIPE, text=True)
-    assert child.stdout.readline().strip() == "ready"
-    child.send_signal(signal.SIGINT)
-    out, _ = child.communicate("go\n", timeout=TIMEOUT)
+    try:
+        assert _readline(child.stdout, TIMEOUT).strip() == "ready"
+        child.send_signal(signal.SIGINT)
+        out, _ = child.communicate("go\n", timeout=TIMEOUT)
+    finally:
+        _end(child)
     assert out.split() == ["pending", "handled"]
     assert child.returncode == 0
 
@@ -152,6 +161,27 @@ def test_the_deferred_sigint_of_this_thread_arrives_as_the_block_ends():
 
 
 # ----------------------------------------------------------------------------- commands
+def _readline(stream, timeout: float) -> str:
+    """The next line of ``stream``, read in a thread: a child that never writes it fails
+    the test after ``timeout`` rather than hanging the suite."""
+    lines: list = []
+    reader = threading.Thread(target=lambda: lines.append(stream.readline()), daemon=True)
+    reader.start()
+    reader.join(timeout)
+    assert lines, f"no line within {timeout} s"
+    return lines[0]
+
+
+def _end(process) -> None:
+    """Whatever the test's outcome: the process's group killed if it still runs, reaped."""
+    if process.poll() is None:
+        try:
+            os.killpg(process.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):   # not a group leader: itself
+            process.kill()
+    process.wait(TIMEOUT)
+
+
 def _alive_in_group(group: int) -> list[str]:
     """The processes of ``group`` still alive (zombies are dead), read from /proc."""
     alive = []
@@ -173,7 +203,7 @@ def interrupt_at(args, moment: str, tmp_path: Path, after: float = 0.0):
     matches ``moment`` (then ``after`` s more): (exit code, stderr, signalled?)."""
     process = subprocess.Popen([str(CADGEN), *map(str, args)], cwd=tmp_path,
                                preexec_fn=_foreground,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                start_new_session=True)
     lines, signalled = [], threading.Event()
 
@@ -190,8 +220,12 @@ def interrupt_at(args, moment: str, tmp_path: Path, after: float = 0.0):
 
     reader = threading.Thread(target=read, daemon=True)
     reader.start()
-    process.stdout.read()
-    process.wait(timeout=TIMEOUT)
+    try:   # bounded: a command that does not end fails the test, not the whole suite
+        process.wait(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        _end(process)
+        raise AssertionError(f"did not end within {TIMEOUT} s of the start:\n"
+                             f"{''.join(lines)[-3000:]}") from None
     reader.join(TIMEOUT)
     deadline = time.monotonic() + 2.0    # every process it started ends with it
     while _alive_in_group(process.pid) and time.monotonic() < deadline:
@@ -320,36 +354,19 @@ def _alive(pid: int) -> bool:
 @POSIX
 @pytest.mark.parametrize("moment", ["drivetrain", "teeth"])
 def test_ctrl_c_stops_the_studio_and_its_build(moment, tmp_path):
-    import json
-    import urllib.request
-
     server = subprocess.Popen([str(CADGEN), "studio", PLANTER, "--no-browser", "--output-dir",
                                str(tmp_path / "out")], cwd=tmp_path, stdout=subprocess.PIPE,
                               stderr=subprocess.PIPE, text=True, start_new_session=True,
                               preexec_fn=_foreground)
     try:
-        url = re.search(r"http://\S+", server.stdout.readline()).group(0)
-        base, token = url.split("/?token=")
-        headers = {"X-Cadgen-Token": token, "Content-Type": "application/json"}
-
-        def call(path, body=None):
-            request = urllib.request.Request(base + path, headers=headers, data=body,
-                                             method="POST" if body else "GET")
-            return urllib.request.urlopen(request, timeout=TIMEOUT)
-
-        params = json.loads(call("/api/design").read())["params"]
-        job = json.loads(call("/api/build", json.dumps({"params": params}).encode()).read())
-        events = call(job["events"])
-        for line in events:   # server-sent events: "data: {...}"
-            if line.startswith(b"data:") and json.loads(line[5:]).get("stage") == moment:
-                break
+        url = re.search(r"http://\S+", _readline(server.stdout, TIMEOUT)).group(0)
+        start_studio_build(url, moment, timeout=TIMEOUT)
         started = _descendants(server.pid)   # the build's process and its workers
         assert started
         os.killpg(server.pid, signal.SIGINT)
         _, stderr = server.communicate(timeout=TIMEOUT)
     finally:
-        if server.poll() is None:
-            os.killpg(server.pid, signal.SIGKILL)
+        _end(server)
     assert server.returncode == 130, stderr[-3000:]
     assert "Traceback" not in stderr and stderr.strip().splitlines()[-1] == "cadgen: interrupted", \
         stderr[-6000:]
