@@ -41,7 +41,17 @@ def test_writes_report_and_plots(params, tmp_path):
                              "ground.stl", "idler-1.stl", "idler-2.stl", "intermediate.stl",
                              "planet-gear-E.stl", "planter-shell.stl", "sun.stl",
                              "train-1-planet.stl", "frame-base.stl", "frame-cover.stl",
-                             *(f"{gear}.stl" for gear in new_gears)])
+                             *(f"{gear}.stl" for gear in new_gears),
+                             # the duckbill linkage
+                             "lever.stl", "push-rod.stl", "blade-link-left.stl",
+                             "blade-link-right.stl",
+                             # a spacer in each gap of 0.5 mm or more between the parts on a
+                             # shaft inside a cavity (2 mm gaps; one long one under E's gear;
+                             # S and C hold only their gear and bearing pair)
+                             *(f"spacer-{axis}-{k}.stl" for axis, count in (
+                                 ("O", 3), ("S", 1), ("input", 2), ("A", 3), ("B", 3),
+                                 ("C2", 2), ("C", 1), ("D", 3), ("E", 2))
+                               for k in range(1, count + 1))])
     report = json.loads((folder / "report.json").read_text())
     assert report["cam"]["cuttable"] and report["cam"]["problems"] == []
     assert all(row["gears_enclosed"] for row in report["solids"]["enclosure"])

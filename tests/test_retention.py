@@ -32,6 +32,17 @@ def test_din_471_rings_as_the_standard_prints_them():
         shaft_ring(16)
 
 
+def test_every_catalogue_shaft_diameter_has_its_ring():
+    # a shaft is sized to a catalogue bearing's bore: each such diameter takes a DIN 471 ring
+    # (a sleeve grows to 45 mm when an optimised arm loads the drive more)
+    from cadgen.machine.catalogue import preferred_diameters
+
+    for d in preferred_diameters():
+        ring = shaft_ring(d)
+        assert ring["d2"] < d and ring["m"] > ring["s"] and ring["d4"] > d, d
+    assert (shaft_ring(45)["s"], shaft_ring(45)["d2"]) == (1.75, 42.5)
+
+
 def _shaft(faces, *, d=20.0, cavity=56.0, name="A", floor_through=False, roof_through=False,
            above=0.0):
     """A shaft in one housing on two bearings of bore ``d``, with keyed gears at ``faces``
