@@ -197,17 +197,13 @@ def shaft_retention(shaft, stacks, bases, hub=None, axial_gap: float = 0.0) -> S
     room = ring["m"] + ring["n"]
     bearing = shaft.seats[0].bearing
     bore = shaft.diameter + SPACER_BORE_CLEARANCE
-    added, screws, problems = [], [], []
-    rings = []
-
-    def add_ring(z0: float):
-        rings.append(z0)
+    added, screws, problems, rings = [], [], [], []
 
     def hold_end(part, below: bool, free: float):
         """A ring beside ``part`` (below or above it), or a set screw when the shaft ends."""
         beyond = part.z0 - ends[0] if below else ends[1] - part.z1
         if beyond >= room - TOUCH and free >= ring["s"] + RING_CLEARANCE - TOUCH:
-            add_ring(part.z0 - ring["s"] if below else part.z1)
+            rings.append(part.z0 - ring["s"] if below else part.z1)
         elif part.kind in ("gear", "hub") and beyond < room - TOUCH:
             key = next((m.key for m in shaft.mounts if m.gear == part.ref), None)
             if part.kind == "hub":
@@ -220,7 +216,7 @@ def shaft_retention(shaft, stacks, bases, hub=None, axial_gap: float = 0.0) -> S
                 f"has {free:.2f} mm beside it, less than its {ring['designation']} needs "
                 f"({ring['s'] + RING_CLEARANCE:g} mm)"))
 
-    ordered = sorted(parts, key=lambda p: p.z0)
+    ordered = parts   # sorted by z0 (_own_parts)
     for group in _groups(ordered, cavities):
         first, last = group[0], group[-1]
         index = ordered.index(first)
@@ -255,7 +251,7 @@ def shaft_retention(shaft, stacks, bases, hub=None, axial_gap: float = 0.0) -> S
                     f"{ring['designation']} and {AXIAL_PLAY:g} mm of play"))
                 continue
             low, high = longest[0].z1, longest[1].z0
-            add_ring(low)
+            rings.append(low)
             for gap in added:
                 if abs(gap[0] - low) < TOUCH and abs(gap[1] - high) < TOUCH:
                     gap[0], gap[1] = low + ring["s"], high - AXIAL_PLAY
