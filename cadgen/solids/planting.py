@@ -38,9 +38,9 @@ side of carrier 1) and where they ride is the assembly model's to say
 (:mod:`cadgen.assembly.machine`, :func:`~cadgen.solids.parts.placed_assembly`).
 The duckbill linkage (lever, push rod, links, the blades' knuckles and cranks, the
 shell's lug, web and hinge ears) is :mod:`cadgen.solids.duckbill`'s, cut to the sizes
-the drivetrain gave it (``fixings["duckbill"]``). Not made as solids: the bought items
-(bearings, the cam roller, keys, screws, pins, the return spring: on the model's
-joints, in the bill).
+the drivetrain gave it (``fixings["duckbill"]``). The bought items (bearings, keys, screws,
+nuts, washers, dowels: on the model's joints, in the bill) are placed as solids by the parts
+that hold them (:mod:`cadgen.solids.bought`).
 """
 
 from __future__ import annotations
@@ -311,8 +311,8 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     parts = parts1 + parts2
     # one solid per shaft (side 1's, in its body's frame): the assembly model places its copies
     hub = drivetrain.fixings.get("planter")
-    planter_hub = (("planter", layout.arm_bottom, layout.arm_bottom + hub["length"], hub["key"]),
-                   ) if hub else ()
+    planter_hub = (("planter", layout.arm_bottom, layout.arm_bottom + hub["length"], hub["key"],
+                    "planter-shell"),) if hub else ()
     held = {(r.shaft, r.side): r for r in drivetrain.retention}
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
@@ -397,15 +397,23 @@ def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
     solid = extrude(contour, thickness, holes=holes,
                     z0=layout.cam_bottom, path="cam.thickness", outline_path="cam contour")
     screwed = drivetrain.fixings.get("cam") if drivetrain is not None else None
+    bought = ()
     if screwed:   # the screws' heads sunk in counterbores: the planter turns just above
+        from cadgen.solids.bought_places import tapped_screws
         from cadgen.solids.extrude import manifold3d_engine
 
         m3d = manifold3d_engine()
         depth, radius = screwed["counterbore_depth"], screwed["counterbore_diameter"] / 2
+        floor = layout.cam_bottom + thickness - depth   # the counterbores' floor: the heads'
         for centre, _ in screws:
             solid = solid - m3d.Manifold.cylinder(depth + 1.0, radius, radius, segments).translate(
-                (centre[0], centre[1], layout.cam_bottom + thickness - depth))
-    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour)
+                (centre[0], centre[1], floor))
+        # the screws on that floor, down into the cover roof's tapped holes
+        bought = tuple(tapped_screws(screwed["bolt"], screwed["screw_length"],
+                                     [centre for centre, _ in screws], floor, up=False,
+                                     fitted=("gearbox2-cover",)))
+    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour,
+                bought=bought)
 
 
 def _planter_parts(params, cam_design, layout, segments, hub=None, duckbill=None):
@@ -560,4 +568,5 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
         return poses(body, phi)
 
     return placed_assembly(parts, pose, planting_model, drivetrain, train,
-                           dict(zip(("gearbox1", "gearbox2", "frame"), housings))), housings, layout
+                           dict(zip(("gearbox1", "gearbox2", "frame"), housings)),
+                           segments=segments), housings, layout
