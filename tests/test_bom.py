@@ -34,6 +34,60 @@ def built(tmp_path_factory):
     return params, result, folder, rows, scene
 
 
+@pytest.fixture(scope="module")
+def built_pricking(tmp_path_factory):
+    params = load_params(REPO / "params" / "kernel-b.toml")
+    root = tmp_path_factory.mktemp("bom-pricking")
+    cadgen.build(params, root, effects=["teeth", "solids", "stl"])
+    folder = root / params.name
+    rows = list(csv.DictReader(io.StringIO((folder / "bom.csv").read_text(encoding="utf-8"))))
+    return rows, trimesh.load(folder / "solids" / "assembly.glb", force="scene")
+
+
+#: How a bill row names its item (its standard's words) -> the stem of the assembly's nodes
+#: that place it as a solid (``bought/<stem>-<n>``), read here from the designation alone.
+_NODE_STEMS = (
+    ("bearing", r"(\d+)$", "bearing-{0}-2Z"),
+    ("key", r"DIN 6885 A (\d+) x (\d+) x (\d+)$", "key-{0}x{1}x{2}"),
+    ("socket head cap screw", r"ISO 4762 (M\d+) x (\d+) - 8\.8$", "screw-{0}x{1}"),
+    ("hexagon nut", r"ISO 4032 (M\d+) - 8$", "nut-{0}"),
+    ("plain washer", r"ISO 7089 (\d+) - 200 HV$", "washer-M{0}"),
+    ("dowel pin", r"ISO 8734 (\d+) x (\d+) - A - St$", "dowel-{0}x{1}"),
+    ("set screw", r"ISO 4027 (M\d+) x (\d+) - 45H$", "set-screw-{0}x{1}"),
+)
+
+
+def _placed_solids(scene, row) -> int:
+    """The assembly file's nodes placing the bought item of a bill row as a solid."""
+    import re
+
+    names = list(scene.graph.nodes_geometry)
+    if row["part"] == "sprocket":    # bought whole, placed as its envelope under the case
+        return sum(1 for n in names if n == "case-sprocket")
+    kind, pattern, stem = next(entry for entry in _NODE_STEMS if entry[0] == row["part"])
+    found = re.search(pattern, row["designation"])
+    assert found, row
+    node = re.compile(rf"bought/{re.escape(stem.format(*found.groups()))}-\d+")
+    return sum(1 for n in names if node.fullmatch(n))
+
+
+@pytest.mark.parametrize("which", ["planting", "pricking"])
+def test_every_bought_row_is_placed_as_often_as_the_bill_says(which, request):
+    """Each bought row of bom.csv (from the assembly model's joints) is as many solids in the
+    written assembly file (from the parts that hold them), counted by the designation."""
+    if which == "planting":
+        _, _, _, rows, scene = request.getfixturevalue("built")
+    else:
+        rows, scene = request.getfixturevalue("built_pricking")
+    bought = [r for r in rows if r["source"] == "buy"]
+    kinds = {r["part"] for r in bought}
+    assert {"bearing", "key", "socket head cap screw", "dowel pin"} <= kinds
+    for row in bought:
+        assert _placed_solids(scene, row) == int(row["quantity"]) > 0, row["designation"]
+    nodes = [n for n in scene.graph.nodes_geometry if n.startswith("bought/")]
+    assert len(nodes) == sum(int(r["quantity"]) for r in bought if r["part"] != "sprocket")
+
+
 def _instances(scene, part: str) -> int:
     """Nodes of the assembly file placing ``part`` (instance names are ``<part>`` or
     ``<part>-<arm or side>``)."""

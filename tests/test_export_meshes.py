@@ -31,8 +31,9 @@ GLB_ATOL_M = 1e-6
 #: STL coordinates are float32 in mm.
 STL_ATOL_MM = 1e-4
 KINDS = ("gear", "housing", "shaft", "spacer", "cam", "planter", "blade", "ground")
-#: Materials: one per kind, and the housings' covers their own (see-through) one.
-MATERIALS = KINDS + ("housing-cover",)
+#: Materials: one per kind, the housings' covers their own (see-through) one, and the bought
+#: solids' (bright steel).
+MATERIALS = KINDS + ("housing-cover", "bought")
 
 
 def _params(build_volume=None, process="printed"):
@@ -110,9 +111,16 @@ def glb(written):
 def test_glb_is_in_metres_and_places_every_part_where_the_assembly_does(planting, glb):
     _, outcome = planting
     tree, binary = _glb_chunks(glb)
-    placements = outcome.assembly.placements(outcome.carrier_angle)
+    # the made parts and the bought solids (bearings, keys, screws, ...) riding on them
+    placements = outcome.assembly.placements(outcome.carrier_angle, bought=True)
     nodes = {node["name"]: node for node in tree["nodes"]}
     assert sorted(nodes) == sorted(name for name, _, _ in placements)
+    bought = [name for name in nodes if name.startswith("bought/")]
+    assert len(bought) == sum(len(part.instances) for part in outcome.assembly.bought) > 100
+    materials = [material["name"] for material in tree["materials"]]
+    for name in bought:   # their own material, none of the made parts'
+        assert materials[tree["meshes"][nodes[name]["mesh"]]["primitives"][0]["material"]] \
+            == "bought", name
     everything = []
     for name, part, pose in placements:
         node = nodes[name]
@@ -181,6 +189,8 @@ def test_glb_materials_differ_by_part_kind_and_housing_covers_are_translucent(pl
     tree, _ = _glb_chunks(glb)
     kind_of = {name: material_key(name, part.kind)
                for name, part, _ in outcome.assembly.placements(outcome.carrier_angle)}
+    kind_of.update({name: "bought" for part in outcome.assembly.bought
+                    for name, _, _ in part.instances})
     assert kind_of["gearbox2-cover-arm1"] == "housing-cover" == kind_of["gearbox1-cover"]
     assert kind_of["gearbox2-base-arm1"] == "housing"
     material_of_kind = {}

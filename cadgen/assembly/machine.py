@@ -230,7 +230,9 @@ def planting_model(drivetrain, meshes=(), *, bodies=None, housings=None,
         held = retention.get((shaft.name, shaft.side))
         screws = dict(held.set_screws) if held is not None else {}
         for side in sides:
-            me = b.instance(f"shaft-{shaft.name}", copy_of(shaft, side))
+            own = f"shaft-{shaft.name}-arm2"   # side 2's own part, its keyseats phased otherwise
+            me = (b.instance(own) if side == 2 and own in (b.bodies or {}) else
+                  b.instance(f"shaft-{shaft.name}", copy_of(shaft, side)))
             bearings = len(b.joints)
             b.joint("revolute", me, housing_part(shaft.seats[0].housing, side), _bearings(shaft),
                     _seat_items(shaft))

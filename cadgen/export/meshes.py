@@ -14,8 +14,10 @@ GLB
     scale); vertex normals split where faces meet at more than
     :data:`CREASE_ANGLE_DEG` (``trimesh.graph.smooth_shade``: flat faces stay flat,
     tessellated curves shade smooth); one named node per placed part with its rigid
-    transform; one geometry per distinct mesh (a part both arms use is stored
-    once); one material per part kind (:data:`PART_MATERIALS`: base colour; housing
+    transform (the bought solids' nodes named ``bought/<item>-<n>``, e.g.
+    ``bought/bearing-6202-2Z-1``); one geometry per distinct mesh (a part both arms use,
+    every screw of one size, is stored once); one material per part kind
+    (:data:`PART_MATERIALS`: base colour, the bought items all ``"bought"``; housing
     covers and the soil translucent with ``alphaMode`` BLEND, so the gears and shafts
     show through the cover while the base stays solid; see :func:`material_key`).
     Deterministic as trimesh writes it.
@@ -94,6 +96,9 @@ PART_MATERIALS = {
     "spacer": (0xA7ADB5, 1.0, 0.7),     # the turned spacers between the parts on a shaft
     "ground": (0x9B7653, 0.35, 0.0),
     "sprocket": (0x4A4F57, 1.0, 0.6),   # a bought steel chain wheel (its envelope)
+    # the bought items (bearings, keys, screws, nuts, washers, dowels): bright steel, lighter
+    # and more metallic than the turned shafts, so a fitter tells what is bought at a glance
+    "bought": (0xC9CED4, 1.0, 0.95),
     "part": (0x8C8C8C, 1.0, 0.1),   # a part of no known kind
 }
 
@@ -451,9 +456,11 @@ def write_solids(outcome, staging) -> list:
     """Write ``solids/<part>.stl`` and ``solids/assembly.<glb|3mf>``; return the relative paths.
 
     ``outcome`` is a :class:`cadgen.solids.outcome.SolidsOutcome`. One binary STL per
-    distinct part in its printing pose (largest flat face down on z = 0, centred on
+    distinct made part in its printing pose (largest flat face down on z = 0, centred on
     x = y = 0; a part both planting arms use is written once), and the assembly with
-    every instance placed, from its part's own frame, at the outcome's carrier angle.
+    every instance placed, from its part's own frame, at the outcome's carrier angle: the
+    made parts and the bought solids (``Assembly.bought``, material ``"bought"``). A bought
+    item has no STL: it is bought, not made, and the assembly file is the one that shows it.
     """
     folder = staging / "solids"
     folder.mkdir()
@@ -462,6 +469,21 @@ def write_solids(outcome, staging) -> list:
         (folder / name).write_bytes(data)
         written.append(f"solids/{name}")
     return written
+
+
+def _bought_offsets(assembly, offsets: dict) -> dict:
+    """Each bought solid's explode offset: its host copy's (a screw comes off with its flange)."""
+    hosts = {part.name: part for part in assembly.parts}
+    out = {}
+    for item in getattr(assembly, "bought", ()):
+        host = hosts.get(item.host)
+        if host is None:
+            continue
+        copies = host.instances or ((host.name, host.body, 0.0),)
+        for (name, _, _), (host_name, _, _) in zip(item.instances, copies):
+            if host_name in offsets:
+                out[name] = offsets[host_name]
+    return out
 
 
 def solids_files(outcome):
@@ -474,13 +496,17 @@ def solids_files(outcome):
                                                lambda: stl_bytes(outcome.printing_mesh(part)))
 
     def assembly():
-        placed = [(name, part.mesh, pose, part.kind) for name, part, pose
-                  in outcome.assembly.placements(outcome.carrier_angle)]
+        bought = {id(part) for part in getattr(outcome.assembly, "bought", ())}
+        every = (outcome.assembly.placements(outcome.carrier_angle, bought=True) if bought
+                 else outcome.assembly.placements(outcome.carrier_angle))
+        placed = [(name, part.mesh, pose, "bought" if id(part) in bought else part.kind)
+                  for name, part, pose in every]
         extras = None
         if outcome.file_type == AssemblyFormat.GLB.value:   # the views' explode slider
             from cadgen.solids.explode import explode_offsets
 
             offsets = explode_offsets(outcome.assembly, outcome.carrier_angle)
+            offsets.update(_bought_offsets(outcome.assembly, offsets))
             extras = {name: {"explode": [round(float(v) * GLTF_METRES_PER_MM, 7)
                                          for v in offset]}
                       for name, offset in offsets.items() if np.any(offset)}

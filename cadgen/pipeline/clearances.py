@@ -28,7 +28,10 @@ angle (see that module for the formula ``v + w * reach + u``):
 
 Which instances are swept is read from the assembly model's placements (the copies on each
 arm; every housing, by the body it rides on), so a part the model adds is swept or refused
-with its name, never left out.
+with its name, never left out. The bought solids riding on those parts are swept with them
+(:mod:`cadgen.solids.bought`: a flange's screw heads, nuts and washers, the keys of the shafts
+that leave gearbox 2, the cam's screws), each bounded by its host's motion over its own reach:
+a screw head standing off a housing is what comes nearest the other arm or the soil.
 
 Each part instance gets its own part's bounds (arm 2 moves like arm 1), and a pair
 of parts is certified with the sum of its two parts' (a cam against a planter shell
@@ -60,13 +63,18 @@ _LINKAGE_KINDS = frozenset({"lever", "push-rod", "link"})
 _SEGMENT = re.compile(r"-\d+$")
 
 
-def arm_groups(assembly) -> tuple[list, list]:
+def arm_groups(assembly, *, bought: bool = False) -> tuple[list, list]:
     """Each planting arm's instances, as the assembly model places them: every part with one
     copy per arm (two copies on one body, half a carrier turn apart), the gears inside
     gearbox 2 left out (its housing stands for them). ``([arm 1's], [arm 2's])``, paired in
-    order; a part the clearance bounds do not know then fails loudly, not silently unswept."""
+    order; a part the clearance bounds do not know then fails loudly, not silently unswept.
+    ``bought``: with the bought solids riding on those parts (a flange's screw heads, nuts and
+    washers, the keys of the shafts that leave the housing): the sweep's groups."""
     first, second = [], []
-    for part in assembly.parts:
+    kinds = {part.name: part.kind for part in assembly.parts}
+    riding = [part for part in getattr(assembly, "bought", ()) if bought
+              and kinds.get(part.host) not in _ENCLOSED_KINDS]
+    for part in list(assembly.parts) + riding:
         copies = part.instances
         if part.kind in _ENCLOSED_KINDS or len(copies) != 2:
             continue
@@ -128,63 +136,100 @@ def _shaft_rates(mechanism, samples: int = 20_000):
             SAMPLED_MARGIN * float(np.max(np.abs(np.gradient(rate, step)))))
 
 
-def _arm_bounds(mechanism, parts, cam) -> tuple:
-    """(speed, acceleration) bounds of any point of one arm's parts that are present."""
-    bounds = _arm_part_bounds(mechanism, parts, cam)
+def _arm_bounds(mechanism, parts, cam, bought=()) -> tuple:
+    """(speed, acceleration) bounds of any point of one arm's parts that are present (and of
+    the ``bought`` solids riding on them)."""
+    bounds = _arm_part_bounds(mechanism, parts, cam, bought)
     return (max(speed for speed, _ in bounds.values()),
             max(acceleration for _, acceleration in bounds.values()))
 
 
-def _arm_part_bounds(mechanism, parts, cam) -> dict:
-    """``{part: (speed, acceleration)}`` bounds of any point of each of one arm's parts present."""
+def _arm_part_bounds(mechanism, parts, cam, bought=()) -> dict:
+    """``{part: (speed, acceleration)}`` bounds of any point of each of one arm's parts present,
+    and of each ``bought`` solid riding on one of them (its host's motion, its own reach)."""
+    rules = _arm_rules(mechanism, parts, cam)
+    bounds = {name: rule(parts[name]) for name, rule in rules.items()}
+    for part in bought:
+        rule = rules.get(part.host)
+        if rule is not None:
+            bounds[part.name] = rule(part)
+    return bounds
+
+
+def _arm_rules(mechanism, parts, cam) -> dict:
+    """``{part present: bound(geometry) -> (speed, acceleration)}``: how fast a point of a solid
+    moving as that part moves can go, given the solid (the part itself, or a bought solid
+    fixed in it, placed as its ``local`` says)."""
     from cadgen.sweep.scene import part_reach
 
     rc = mechanism.carrier_radii["C"]
     spin, turn = _planter_turn(mechanism)
-    bounds = {}
+    rules = {}
+
+    def fixed(part):
+        box = rc + part_reach(part, axis=_Z)
+        return box, box
+
     for name in _present(_GEARBOX2_FIXED, parts):
-        box = rc + part_reach(parts[name], axis=_Z)
-        bounds[name] = (box, box)
+        rules[name] = fixed
     shafts = [name for name in _GEARBOX2_SHAFTS if name in parts]
     if shafts:
         rate, rate_rate = _shaft_rates(mechanism)
-        for name in shafts:
-            shaft = parts[name]
-            radius = float(np.max(np.linalg.norm(shaft.mesh.vertices[:, :2], axis=1)))
+
+        def spinning(part, shaft):
+            # the solid in the shaft's own frame (the shaft itself: as it is), about its axis
+            local = np.linalg.solve(shaft.local(0.0), part.local(0.0))
+            vertices = part.mesh.vertices @ local[:3, :3].T + local[:3, 3]
+            radius = float(np.max(np.linalg.norm(vertices[:, :2], axis=1)))
             reach = float(np.hypot(*shaft.local(0.0)[:2, 3])) + radius
-            bounds[name] = (rc + reach + rate * radius,
-                            rc + reach + (2 * rate + rate**2 + rate_rate) * radius)
+            return (rc + reach + rate * radius,
+                    rc + reach + (2 * rate + rate**2 + rate_rate) * radius)
+
+        for name in shafts:
+            rules[name] = lambda part, shaft=parts[name]: spinning(part, shaft)
     if "planter-shell" in parts:
-        reach = part_reach(parts["planter-shell"], axis=_Z)
-        bounds["planter-shell"] = (mechanism.speed_bound("E") + spin * reach,
-                                   mechanism.acceleration_bound("E") + turn * reach)
+        def planter(part):
+            reach = part_reach(part, axis=_Z)
+            return (mechanism.speed_bound("E") + spin * reach,
+                    mechanism.acceleration_bound("E") + turn * reach)
+
+        rules["planter-shell"] = planter
     blades = [name for name in ("blade-right", "blade-left") if name in parts]
     if blades:
         rate, rate_rate = _blade_rates(cam, mechanism) if cam is not None else (0.0, 0.0)
-        for name in blades:
-            blade = parts[name]
+
+        def blade(part, name):
             if cam is None:   # closed blades ride on the planter like its shell
-                reach_e, reach_h = part_reach(blade, axis=_Z), 0.0
+                reach_e, reach_h = part_reach(part, axis=_Z), 0.0
             else:
                 hinge = _hinge(cam.linkage, name)
-                reach_h = part_reach(blade, body_origin_local=(*hinge, 0.0), axis=_Z)
+                reach_h = part_reach(part, body_origin_local=(*hinge, 0.0), axis=_Z)
                 # however far it opens, no point of it is farther from E than this
                 reach_e = float(np.hypot(*hinge)) + reach_h
-            bounds[name] = (mechanism.speed_bound("E") + spin * reach_e + rate * reach_h,
-                            mechanism.acceleration_bound("E") + turn * reach_e
-                            + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
-    for name, part in parts.items():
-        if part.kind in _LINKAGE_KINDS and cam is not None:
-            speed, acceleration, reach_e = _linkage_motion(cam, part)
-            bounds[name] = (mechanism.speed_bound("E") + spin * reach_e + speed,
-                            mechanism.acceleration_bound("E") + turn * reach_e + acceleration
-                            + 2 * spin * speed)
-    return bounds
+            return (mechanism.speed_bound("E") + spin * reach_e + rate * reach_h,
+                    mechanism.acceleration_bound("E") + turn * reach_e
+                    + (rate_rate + rate**2 + 2 * spin * rate) * reach_h)
+
+        for name in blades:
+            rules[name] = lambda part, name=name: blade(part, name)
+    if cam is not None:   # the duckbill's lever, push rod and links, each by its own motion
+        def linkage(part, host):
+            speed, acceleration, reach_e = _linkage_motion(cam, part, host)
+            return (mechanism.speed_bound("E") + spin * reach_e + speed,
+                    mechanism.acceleration_bound("E") + turn * reach_e + acceleration
+                    + 2 * spin * speed)
+
+        for name, host in parts.items():
+            if host.kind in _LINKAGE_KINDS:
+                rules[name] = lambda part, host=host: linkage(part, host)
+    return rules
 
 
-def _linkage_motion(cam, part, samples: int = 20_000):
+def _linkage_motion(cam, part, host=None, samples: int = 20_000):
     """A duckbill linkage part's motion in the planter: the largest speed and acceleration (per
-    carrier radian, sampled, +25 %) of any of its points there, and its largest reach from E."""
+    carrier radian, sampled, +25 %) of any of its points there, and its largest reach from E.
+    ``part``: the solid (the linkage part, or a solid fixed in it and placed with it); ``host``:
+    the linkage part it moves as (default ``part``)."""
     from cadgen.sweep.scene import part_reach
 
     phi = np.linspace(0.0, 2 * np.pi, samples + 1)
@@ -196,14 +241,15 @@ def _linkage_motion(cam, part, samples: int = 20_000):
         rate = np.gradient(values, step, axis=0)
         return rate, np.gradient(rate, step, axis=0)
 
-    if part.kind == "lever":   # turns about H
+    host = part if host is None else host
+    if host.kind == "lever":   # turns about H
         pivot = linkage.lever_pivot
         reach = part_reach(part, body_origin_local=(*pivot, 0.0), axis=_Z)
         rate, rate_rate = rates(lam)
         speed = np.abs(rate) * reach
         acceleration = (np.abs(rate_rate) + rate**2) * reach
         reach_e = float(np.hypot(*pivot)) + reach
-    elif part.kind == "push-rod":   # slides along the duckbill axis
+    elif host.kind == "push-rod":   # slides along the duckbill axis
         travel = linkage.rod_arm * np.sin(lam)
         rate, rate_rate = rates(travel)
         speed, acceleration = np.abs(rate), np.abs(rate_rate)
@@ -211,7 +257,7 @@ def _linkage_motion(cam, part, samples: int = 20_000):
     else:   # a link, from its blade's crank pin J to the rod's end P2 (its frame's origin at J)
         beta = linkage.opening_of_lever(lam)
         pin = linkage.crank_pin(beta)
-        if part.name.endswith("left"):
+        if host.name.endswith("left"):
             pin = np.stack([-2.0 * linkage.L1 - pin[:, 0], pin[:, 1]], axis=-1)
         end_y = linkage.push_rod_end(beta)
         angle = np.unwrap(np.arctan2(end_y - pin[:, 1], -linkage.L1 - pin[:, 0]))
@@ -316,10 +362,12 @@ def arm_interference(params, mechanism, solids, cam, evaluation=None) -> dict:
 
     assembly = solids.assembly
     parts = {part.name: part for part in assembly.parts}
-    arm1, arm2 = arm_groups(assembly)
+    bought = list(getattr(assembly, "bought", ()))
+    arm1, arm2 = arm_groups(assembly, bought=True)
     scene = FclScene(assembly, arm1, arm2)
-    bounds = _arm_part_bounds(mechanism, parts, cam)
-    part_of = {name: part.name for part in assembly.parts for name, _, _ in part.instances}
+    bounds = _arm_part_bounds(mechanism, parts, cam, bought)
+    part_of = {name: part.name for part in assembly.parts + bought
+               for name, _, _ in part.instances}
     # arm 2 moves like arm 1, half a turn on: each instance has its part's bounds, and the
     # distance repeats every half turn
     speed = max(value for value, _ in bounds.values())
@@ -340,6 +388,14 @@ def _arm_distance_estimate(params, mechanism):
     return arm_distance(mechanism, steps=params.resolution.steps_per_revolution).value
 
 
+def _with_riding(assembly, kinds) -> list:
+    """The parts of ``kinds`` and the bought solids riding on them (a housing's flange bolts,
+    nuts and washers, its dowels, its bearings; the screws under the pricking sprocket)."""
+    parts = [part for part in assembly.parts if part.kind in kinds]
+    hosts = {part.name for part in parts}
+    return parts + [part for part in getattr(assembly, "bought", ()) if part.host in hosts]
+
+
 def ground_clearance(params, design, solids, field) -> dict:
     """Certified least gap between every housing and the ground mesh over a revolution."""
     from cadgen.sweep.fcl import FclScene
@@ -355,7 +411,7 @@ def ground_clearance(params, design, solids, field) -> dict:
         centre = (*np.asarray(link.centre, dtype=float), 0.0)
         reach = {name: (0.0 if body == "frame" else
                         part_reach(part, body_origin_local=centre, axis=_Z))
-                 for part in assembly.parts if part.kind in ("housing", "sprocket")
+                 for part in _with_riding(assembly, ("housing", "sprocket"))
                  for name, body, _ in part.instances}
         housings = list(reach)
         speed = max(reach.values())
@@ -369,9 +425,7 @@ def ground_clearance(params, design, solids, field) -> dict:
     # gearbox 1 turns about O at rate 1; gearbox 2 about C, which circles at rc (a point moves
     # at most its reach, and accelerates at most the same, per radian); the frame is fixed
     reach, frame = {}, []
-    for part in assembly.parts:
-        if part.kind != "housing":
-            continue
+    for part in _with_riding(assembly, ("housing",)):
         for name, body, _ in part.instances:
             reach[name] = _housing_reach(part, body.split(":")[0], rc)
             if body == "frame":

@@ -174,9 +174,9 @@ def overall_checks(report: dict) -> list[tuple[str, bool, str]]:
             bad = overlaps.get("failures", [])
             checks.append(("no parts overlap", not bad,
                            "; ".join(bad) if bad else
-                           f"{overlaps['pairs_examined']} touching pairs intersected at "
+                           f"{overlaps['pairs_examined']} touching pairs checked at "
                            f"{_number(overlaps['carrier_angle_deg'], trim=True)} deg: only "
-                           "their fits' chord-error shells"))
+                           "their fits' chord-error shells and screw threads"))
             covered.append("parts overlap at the assembly pose")
     if "stages" in report:
         bad = [f"{s['stage']} {s.get('status')}" for s in report["stages"]

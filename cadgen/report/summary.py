@@ -245,7 +245,9 @@ def format_solids(solids: dict) -> str:
     density = (f"{_number(solids['density_kg_m3'], 'g')} kg/m3"
                if solids.get("density_kg_m3") is not None else
                f"each part's material ({solids.get('process', 'machined')})")
-    lines = [f"solids: {len(parts)} parts ({instances} placed), total mass "
+    bought = (solids.get("bought") or {}).get("placed")
+    placed = f"{instances} placed" + (f", and {bought} bought solids" if bought else "")
+    lines = [f"solids: {len(parts)} parts ({placed}), total mass "
              f"{_number(solids['total_mass_kg'], '.2f')} kg at {density}, assembly at carrier "
              f"angle {_number(solids['assembly']['carrier_angle_deg'], 'g')} deg"]
     for row in solids["enclosure"]:
@@ -265,7 +267,7 @@ def format_solids(solids: dict) -> str:
             lines += [f"     OVERLAP: {failure}" for failure in overlaps["failures"]]
         else:
             lines.append(f"     no parts overlap ({overlaps['pairs_examined']} touching pairs "
-                         "intersected; only their fits' chord-error shells)")
+                         "checked; only their fits' chord-error shells and screw threads)")
     printed = [p for p in parts if p.get("overhang_mm2") is not None]
     if printed:
         needing = [p for p in printed if p.get("supports_needed")]

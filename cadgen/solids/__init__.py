@@ -25,9 +25,16 @@ machine_parts
 fixing_features
     The holes and bosses the fixings need: tapped holes, passages, the cam's screw holes,
     a keyed hub's boss and bore.
-overlaps
+bought, bought_makers, bought_places
+    The bought items as solids: :func:`~cadgen.solids.bought.register_maker` (a maker per
+    kind, from its catalogue dimensions), :class:`~cadgen.solids.bought.BoughtItem` (one
+    item where it sits in the part that holds it, ``Part.bought``),
+    :func:`~cadgen.solids.bought.bought_parts` (placed with every copy of that part); the
+    catalogue kinds' shapes; the placements read from the records that cut their seats.
+overlaps, contact
     :func:`~cadgen.solids.overlaps.overlap_check`: the parts sharing material at the
-    assembly pose, a joint's fit told from a collision by the overlap's thickness.
+    assembly pose, a joint's fit told from a collision by the overlap's thickness; the
+    bought solids' contacts screened first with FCL.
 mass
     :func:`mass_properties`: volume, area, mass, centre of mass, inertia (mm, kg).
 housings, ground, parts, planting, pricking, outcome

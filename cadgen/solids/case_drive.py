@@ -69,5 +69,15 @@ def case_drive_parts(held: dict, sun_shaft, sun_part, centre, floor_wall: float,
                     holes=[circle(sprocket["bore"] / 2, segments, tuple(centre)), *screws],
                     z0=-floor_wall - sprocket["width"], path="case_drive.sprocket")
     fixed = planar_transform(0.0)
+    # the sprocket is bought whole (its bill row's designation): its screws go up from under
+    # it into the case floor's tapped holes
+    from cadgen.assembly.items import sprocket_items
+    from cadgen.solids.bought import BoughtPart
+    from cadgen.solids.bought_places import tapped_screws
+
+    screws = tapped_screws(sprocket["bolt"], None, bolt_circle(sprocket, tuple(centre)),
+                           -floor_wall - sprocket["width"], up=True, clamped=sprocket["width"],
+                           fitted=("gear-case-base",))
     return [Part("frame-bracket", "housing", "frame", plate + boss, lambda angle: fixed),
-            Part("case-sprocket", "sprocket", "case", wheel, lambda angle: fixed)]
+            BoughtPart("case-sprocket", "sprocket", "case", wheel, lambda angle: fixed,
+                       bought=tuple(screws), designation=sprocket_items(held)[0].designation)]

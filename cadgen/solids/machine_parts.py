@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from cadgen.solids.parts import Part, planar_transform
 
 __all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "with_dowels", "dowel_positions",
@@ -101,7 +103,6 @@ def dowel_positions(housing) -> list:
     """Where a split housing's two dowels go: in the flange between two bolts, the two gaps
     farthest apart (the cover is then located across its whole length), each on the flange's
     middle line (half way between the housing's outer outline and the flange's)."""
-    import numpy as np
     import shapely
 
     bolts = np.asarray(housing.bolt_positions, dtype=float)
@@ -144,12 +145,16 @@ def with_dowels(housing):
 
 def housing_parts(name: str, housing, body: str) -> list:
     """``[<name>-base, <name>-cover]`` parts of kind ``housing`` on ``body`` (their copies are
-    the assembly model's to place)."""
+    the assembly model's to place); the base holds the housing's bought items (the seats'
+    bearings, the flange's bolts, the dowels: :func:`~cadgen.solids.bought_places.housing_items`)."""
+    from cadgen.solids.bought_places import housing_items
+
     parts = []
     for piece, solid in (("base", housing.base), ("cover", housing.cover)):
         stem = f"{name}-{piece}"
         # seen along z a half is its flange's outline (the holes through it aside)
         parts.append(Part(stem, "housing", body, solid, footprint=housing.flange_outline))
+    parts[0].bought = tuple(housing_items(name, housing))
     return parts
 
 
@@ -191,6 +196,10 @@ def printed_housing_parts(name: str, housing, body: str, params) -> tuple:
         for piece in split.pieces:
             stem = f"{name}-{half}-{piece.suffix}"
             parts.append(Part(stem, "housing", body, getattr(piece, half)))
+    from cadgen.solids.bought_places import housing_items
+
+    # the first base segment holds every bought item of the housing (one body, one frame)
+    parts[0].bought = tuple(housing_items(name, housing, split.joints))
     return parts, list(split.joints)
 
 
@@ -205,7 +214,6 @@ def printer_cuts(housing, params, *, name: str = "housing", parts=None) -> list:
     DesignError
         At ``manufacturing.build_volume`` when no split between the seats fits.
     """
-    import numpy as np
 
     from cadgen.solids.outcome import fits_build_volume, printing_pose
 
@@ -254,6 +262,30 @@ def _turn_of(transform) -> float:
     return math.atan2(transform[1, 0], transform[0, 0])
 
 
+def _keyed_frames(shaft, gears, hubs=()):
+    """``(gears, first, turns)``: the shaft's own gears and hubs of ``gears``, the placement
+    of the first keyed one (the shaft turns with it; None: no gear placed) and each one's
+    keyway direction at phi = 0 in the shaft's frame (rad)."""
+    gears = {name: value for name, value in (gears or {}).items()
+             if name in {mount.gear for mount in shaft.mounts} | {hub[0] for hub in hubs}}
+    # the shaft turns with its keyed gears (a gear running free on its bearings does not)
+    first = next((gears[m.gear][0] for m in shaft.mounts
+                  if m.gear in gears and getattr(m, "bearing", None) is None), None)
+    frame0 = _turn_of(first(0.0)) if first is not None else 0.0
+    return gears, first, {name: _turn_of(local(0.0)) + keyway - frame0
+                          for name, (local, keyway) in gears.items()}
+
+
+def keyseat_turns(shaft, gears, hubs=()) -> dict:
+    """Each keyed gear's (and hub's) keyseat direction on ``shaft``, rad in [0, 2 pi) from the
+    first's: the phasing the workshop cuts (``gears`` as :func:`shaft_part`'s)."""
+    _, _, turns = _keyed_frames(shaft, gears, hubs)
+    keyed = {m.gear for m in shaft.mounts if m.key is not None} | {
+        hub[0] for hub in hubs if hub[3] is not None}
+    return {name: float(np.mod(turn, 2 * np.pi)) for name, turn in turns.items()
+            if name in keyed}
+
+
 def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=(),
                retention=None) -> Part:
     """The shaft of a :class:`~cadgen.machine.model.Shaft` record as a part on ``body``.
@@ -270,62 +302,83 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=(),
     the keyseats' relative angles are the gears' phasing on the shaft, which the workshop
     cuts into it. Without it the shaft is fixed in the body, keyseats towards +x.
 
-    ``hubs``: ``(name, z_bottom, z_top, key)`` of the other parts keyed to the shaft (the
-    planter on E, the rocker on the planet shaft; z in the body frame), each with its
-    placement and keyway in ``gears`` under ``name``: a keyseat centred on its hub.
+    ``hubs``: ``(name, z_bottom, z_top, key[, part])`` of the other parts keyed to the shaft
+    (the planter on E, the rocker on the planet shaft; z in the body frame), each with its
+    placement and keyway in ``gears`` under ``name``: a keyseat centred on its hub (``part``:
+    the hub's part, when its name is not ``name``).
 
     ``retention`` (:class:`~cadgen.machine.retention.ShaftRetention`): a DIN 471 groove for
     each of its retaining rings.
+
+    The part holds what is bought with it (:mod:`cadgen.solids.bought_places`): a key in each
+    keyseat (fitted to its gear or hub), the two bearings of each gear running free on it, a
+    hollow shaft's flange screws.
     """
+    from cadgen.solids.bought_places import bearing_pair, key_item
     from cadgen.solids.split_housing import shaft_solid
 
     z_bottom, z_top = shaft_ends(shaft, housing)
-    gears = {name: value for name, value in (gears or {}).items()
-             if name in {mount.gear for mount in shaft.mounts} | {hub[0] for hub in hubs}}
-    # the shaft turns with its keyed gears (a gear running free on its bearings does not)
-    first = next((gears[m.gear][0] for m in shaft.mounts
-                  if m.gear in gears and getattr(m, "bearing", None) is None), None)
-    frame0 = _turn_of(first(0.0)) if first is not None else 0.0
+    gears, first, turns = _keyed_frames(shaft, gears, hubs)
 
     def direction(name: str) -> float:
-        # the keyway's direction in the body at phi = 0, in the shaft's frame
-        if name not in gears:
-            return 0.0
-        local, keyway = gears[name]
-        return _turn_of(local(0.0)) + keyway - frame0
+        return turns.get(name, 0.0)
 
-    keyseats, flat, flat_angle = [], 0.0, 0.0
+    radius = shaft.diameter / 2
+    keyseats, flat, flat_angle, bought = [], 0.0, 0.0, []
     for mount in shaft.mounts:
+        gear = mount.gear.replace(" ", "-")   # its part's file stem
+        middle = housing.z_cavity_bottom + mount.z_bottom + mount.face_width / 2
         if mount.key is not None:
-            middle = housing.z_cavity_bottom + mount.z_bottom + mount.face_width / 2
             length = min(mount.key.length, mount.face_width)
             keyseats.append((middle - length / 2, middle + length / 2, mount.key.width,
                              mount.key.shaft_depth, direction(mount.gear)))
+            bought.append(key_item(mount.key, middle - mount.key.length / 2,
+                                   direction(mount.gear), radius, (gear,)))
+        if getattr(mount, "bearing", None) is not None:   # it runs free on two bearings
+            bought += bearing_pair(mount.bearing, middle, (gear,))
         if float(mount.flat_depth or 0.0) > flat:
             flat, flat_angle = float(mount.flat_depth), direction(mount.gear)
-    for name, z_low, z_high, key in hubs:   # a keyseat centred on each other keyed hub
+    for name, z_low, z_high, key, *part in hubs:   # a keyseat centred on each other keyed hub
         if key is not None:
             middle = 0.5 * (z_low + z_high)
             keyseats.append((middle - key.length / 2, middle + key.length / 2, key.width,
                              key.shaft_depth, direction(name)))
+            bought.append(key_item(key, middle - key.length / 2, direction(name), radius,
+                                   (part[0] if part else name,)))
     coupling = getattr(shaft, "coupling_key", None)
     if coupling is not None:   # the stub's keyseat, centred on the stub below the floor
         stub_top = housing.z_cavity_bottom - housing.floor_wall
         middle = 0.5 * (z_bottom + stub_top)
         keyseats.append((middle - coupling.length / 2, middle + coupling.length / 2,
                          coupling.width, coupling.shaft_depth, 0.0))
+        bought.append(key_item(coupling, middle - coupling.length / 2, 0.0, radius))
     solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
                         flat_angle=flat_angle, segments=segments)
     solid = _ring_grooves(solid, shaft, retention, housing.z_cavity_bottom, segments)
     if getattr(shaft, "bore", 0.0) > 0.0:
         solid = _hollow(solid, shaft, z_bottom, z_top, segments)
+        bought += flange_screws(shaft.flange, z_top)
     offset = tuple(float(v) for v in shaft.xy)
     if first is None:
         local = (lambda phi, at=planar_transform(0.0, offset): at)
     else:   # the gears on one shaft turn together: the shaft turns with the first of them
         def local(phi, first=first, offset=offset):
             return planar_transform(_turn_of(first(phi)), offset)
-    return Part(f"shaft-{shaft.name}", "shaft", body, solid, local)
+    return Part(f"shaft-{shaft.name}", "shaft", body, solid, local, bought=tuple(bought))
+
+
+def flange_screws(flange, z_top: float) -> list:
+    """A hollow shaft's flange screws (the bill's) put in from under its flange (its top at
+    ``z_top``) through the clearance holes of :func:`flange_bolt_holes` into the tapped holes
+    of the housing it carries, on the same bolt circle."""
+    if not flange:
+        return []
+    from cadgen.machine.fastening import bolt_circle
+    from cadgen.solids.bought_places import tapped_screws
+
+    thickness = float(flange["thickness"])
+    return tapped_screws(flange["bolt"], None, bolt_circle(flange), z_top - thickness, up=True,
+                         clamped=thickness, fitted=(f"{flange['carries']}-base",))
 
 
 def _hollow(solid, shaft, z_bottom: float, z_top: float, segments: int):

@@ -361,6 +361,21 @@ def _alignment(outcome: SolidsOutcome, fits) -> list:
     return rows
 
 
+def _bought_report(outcome: SolidsOutcome) -> dict:
+    """The bought solids placed in the assembly file: how many, of each kind and designation
+    (the bill's words; :func:`cadgen.solids.bought.placed_designations`)."""
+    from collections import Counter
+
+    from cadgen.solids.bought import placed_designations
+
+    bought = list(getattr(outcome.assembly, "bought", ()))
+    kinds = Counter()
+    for part in bought:
+        kinds[part.kind] += len(part.instances)
+    return {"placed": int(sum(kinds.values())), "kinds": dict(sorted(kinds.items())),
+            "designations": dict(sorted(placed_designations(outcome.assembly).items()))}
+
+
 def solids_report(outcome: SolidsOutcome) -> dict:
     """Mass properties per part, the enclosure checks and the assembly's pose (report.json);
     computed once per outcome (a copy each call)."""
@@ -407,7 +422,7 @@ def _solids_report(outcome: SolidsOutcome) -> dict:
             "print_extents_mm": extents, "fits_build_volume": fits,
         })
     return {"density_kg_m3": outcome.density, "process": outcome.process,
-            "parts": parts, "total_mass_kg": total,
+            "parts": parts, "total_mass_kg": total, "bought": _bought_report(outcome),
             "assembly": {"file": f"solids/assembly.{outcome.file_type}",
                          "carrier_angle_deg": float(np.degrees(outcome.carrier_angle)),
                          "units": "m" if outcome.file_type == "glb" else "mm"},

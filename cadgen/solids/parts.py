@@ -55,6 +55,10 @@ class Part:
     footprint : (n, 2) float, optional
         The part seen along z (its silhouette in its own frame) when known in closed form: a
         housing half's flange outline. Pictures draw it instead of merging the triangles.
+    bought : tuple of BoughtItem
+        The bought items fixed in it, in its own frame (:mod:`cadgen.solids.bought`): the
+        bearings in its seats, the keys in its keyseats, the screws in its holes. The assembly
+        places them as solids riding with it (``Assembly.bought``).
     """
 
     name: str
@@ -65,6 +69,7 @@ class Part:
     instances: tuple = ()     # ((instance name, body, phase offset rad), ...); empty: one at body
     outline: object = None    # (n, 2) section of a z-prism part (gears), for exact 2D checks
     footprint: object = None  # (n, 2) silhouette along z, when known (housing halves)
+    bought: tuple = ()        # BoughtItem records of what is fixed in it (its own frame)
     _mesh: object = field(default=None, repr=False)
 
     @property
@@ -92,11 +97,15 @@ class Assembly:
     #: ``angles -> None``: solve the poses of many carrier angles at once (a mechanism whose
     #: pose needs an inverse solve); the default does nothing
     prepare: Callable = field(default=lambda angles: None, repr=False)
+    #: the bought solids (:class:`~cadgen.solids.bought.BoughtPart`) riding on the parts' bodies,
+    #: apart from ``parts`` (the made parts: their files, masses, bill rows)
+    bought: list = field(default_factory=list)
 
-    def placements(self, phi: float):
-        """``[(instance name, part, 4x4 world transform)]`` at carrier angle ``phi`` (rad)."""
+    def placements(self, phi: float, *, bought: bool = False):
+        """``[(instance name, part, 4x4 world transform)]`` at carrier angle ``phi`` (rad), of
+        the made parts (and, ``bought``, the bought solids after them)."""
         out = []
-        for part in self.parts:
+        for part in list(self.parts) + (list(self.bought) if bought else []):
             instances = part.instances or ((part.name, part.body, 0.0),)
             for name, body, phase in instances:
                 pose = self.body_pose(body, phi + phase) @ part.local(phi + phase)
@@ -104,7 +113,8 @@ class Assembly:
         return out
 
 
-def placed_assembly(parts, body_pose, build_model, drivetrain, train, housings) -> Assembly:
+def placed_assembly(parts, body_pose, build_model, drivetrain, train, housings, *,
+                    segments: int = 96) -> Assembly:
     """The assembly of ``parts``, each placed as often and where the assembly model says.
 
     ``build_model`` is :func:`cadgen.assembly.machine.planting_model` or
@@ -112,7 +122,11 @@ def placed_assembly(parts, body_pose, build_model, drivetrain, train, housings) 
     the housing records, and decides which copies exist (per arm, per side of carrier 1) and
     what bought items their joints need. Each part's ``instances`` are then the model's
     placements of it; a part the model does not know (the soil) stays one copy on its body.
+    The items the parts hold (their ``bought``) are placed as solids with each copy
+    (:func:`cadgen.solids.bought.bought_parts`, round features of ``segments`` sides).
     """
+    from cadgen.solids.bought import bought_parts
+
     meshes = [tuple(stage.generated.pair.names) for stage in (train.stages if train else ())]
     model = build_model(drivetrain, meshes, bodies={part.name: part.body for part in parts},
                         housings=housings, kinds={part.name: part.kind for part in parts})
@@ -120,7 +134,7 @@ def placed_assembly(parts, body_pose, build_model, drivetrain, train, housings) 
         part.instances = model.instances_of(part.name)
     for body in dict.fromkeys(p.body for p in model.placements):
         body_pose(body, 0.0)   # a body the mechanism does not move is a KeyError here, not later
-    return Assembly(parts, body_pose, model)
+    return Assembly(parts, body_pose, model, bought=bought_parts(parts, segments))
 
 
 def gear_solid(profile, face_width: float, segments: int, path: str, chord_tolerance: float):

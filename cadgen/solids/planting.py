@@ -38,9 +38,9 @@ side of carrier 1) and where they ride is the assembly model's to say
 (:mod:`cadgen.assembly.machine`, :func:`~cadgen.solids.parts.placed_assembly`).
 The duckbill linkage (lever, push rod, links, the blades' knuckles and cranks, the
 shell's lug, web and hinge ears) is :mod:`cadgen.solids.duckbill`'s, cut to the sizes
-the drivetrain gave it (``fixings["duckbill"]``). Not made as solids: the bought items
-(bearings, the cam roller, keys, screws, pins, the return spring: on the model's
-joints, in the bill).
+the drivetrain gave it (``fixings["duckbill"]``). The bought items (bearings, keys, screws,
+nuts, washers, dowels: on the model's joints, in the bill) are placed as solids by the parts
+that hold them (:mod:`cadgen.solids.bought`).
 """
 
 from __future__ import annotations
@@ -61,6 +61,8 @@ __all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius", "GEARLESS_K
 #: drivetrain's stacks, not from the gears' outlines. Not the gears, not the shafts (each
 #: keyseat turns to its gear's keyway). A build sweeps the gearless assembly beside the teeth
 #: and takes these parts' meshes from it (:mod:`cadgen.pipeline.beside`).
+#: rad: side 2's keyseats within this of side 1's are cut alike (one shaft part for both).
+SAME_KEYSEAT_RAD = 1e-6
 GEARLESS_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground", "lever", "push-rod",
                             "link"})
 
@@ -249,15 +251,26 @@ def _gear_parts(params, mechanism, train, layout, segments):
 
 def _in_carrier(body, local, start, keyway):
     """A gear's ``(placement, keyway)`` for the keyseat of its shaft; a gearbox-2 gear (the
-    central gear, whose shaft C2 rides on carrier 1) also as seen from carrier 1's body:
-    ``{"gearbox2": ..., "carrier1": ...}`` by the shaft's body."""
+    central gear, whose shaft C2 rides on carrier 1) also as seen from carrier 1's body, on
+    side 1 (arm 1's gearbox 2) and on side 2 (``carrier1:mirrored``, arm 2's, half a carrier
+    turn on): ``{"gearbox2": ..., "carrier1": ..., "carrier1:mirrored": ...}`` by the shaft's
+    body. A carrier-1 gear's side-2 copy is side 1's turned about O: the same placement."""
+    if body == "carrier1":
+        return {body: (local, keyway), "carrier1:mirrored": (local, keyway)}
     if body != "gearbox2":
         return {body: (local, keyway)}
 
     def seen_from_carrier(phi, local=local):
         return np.linalg.solve(start("carrier1", phi), start("gearbox2", phi) @ local(phi))
 
-    return {"gearbox2": (local, keyway), "carrier1": (seen_from_carrier, keyway)}
+    def seen_from_side2(phi, local=local):
+        # arm 2's gearbox 2 is arm 1's half a carrier turn later; side 2 is side 1 turned
+        # half a turn about O at the same carrier angle
+        side2 = start("carrier1", phi) @ planar_transform(math.pi)
+        return np.linalg.solve(side2, start("gearbox2", phi + math.pi) @ local(phi + math.pi))
+
+    return {"gearbox2": (local, keyway), "carrier1": (seen_from_carrier, keyway),
+            "carrier1:mirrored": (seen_from_side2, keyway)}
 
 
 def _frames_for(frames, body: str) -> dict:
@@ -311,8 +324,8 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     parts = parts1 + parts2
     # one solid per shaft (side 1's, in its body's frame): the assembly model places its copies
     hub = drivetrain.fixings.get("planter")
-    planter_hub = (("planter", layout.arm_bottom, layout.arm_bottom + hub["length"], hub["key"]),
-                   ) if hub else ()
+    planter_hub = (("planter", layout.arm_bottom, layout.arm_bottom + hub["length"], hub["key"],
+                    "planter-shell"),) if hub else ()
     held = {(r.shaft, r.side): r for r in drivetrain.retention}
     for shaft in drivetrain.shafts:
         if shaft.housing == "gearbox2":
@@ -325,6 +338,8 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
         part = shaft_part(shaft, housing, body, segments=segments,
                           gears=_frames_for(gears, body), hubs=hubs, retention=stack)
         parts += [part] + spacer_parts(part, stack, housing.z_cavity_bottom, segments)
+        if body == "carrier1":
+            parts += _side2_shaft(shaft, housing, stack, gears, segments)
     housings = (housing1, housing2)
     if "frame" in drivetrain.stacks:
         frame, frame_parts = _frame_parts(params, mechanism, drivetrain, layout, segments, gears)
@@ -333,6 +348,24 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     return parts, housings
 
 
+
+
+def _side2_shaft(shaft, housing, stack, gears, segments) -> list:
+    """Side 2's own copy of a carrier-1 shaft whose keyseats are phased otherwise than side
+    1's (C2: planet I turns with side 2 about O, arm 2's central gear does not), named
+    ``shaft-<axis>-arm2`` and placed on ``carrier1:mirrored``; none when side 1's fits."""
+    from dataclasses import replace
+
+    from cadgen.solids.machine_parts import keyseat_turns, shaft_part
+
+    side1 = keyseat_turns(shaft, _frames_for(gears, "carrier1"))
+    side2 = keyseat_turns(shaft, _frames_for(gears, "carrier1:mirrored"))
+    apart = [abs(math.remainder(side2[name] - side1[name], 2 * math.pi)) for name in side1]
+    if max(apart, default=0.0) <= SAME_KEYSEAT_RAD:
+        return []
+    part = shaft_part(shaft, housing, "carrier1:mirrored", segments=segments,
+                      gears=_frames_for(gears, "carrier1:mirrored"), retention=stack)
+    return [replace(part, name=f"{part.name}-arm2")]
 
 
 def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
@@ -397,15 +430,23 @@ def _cam_part(params, mechanism, cam_design, layout, segments, drivetrain=None):
     solid = extrude(contour, thickness, holes=holes,
                     z0=layout.cam_bottom, path="cam.thickness", outline_path="cam contour")
     screwed = drivetrain.fixings.get("cam") if drivetrain is not None else None
+    bought = ()
     if screwed:   # the screws' heads sunk in counterbores: the planter turns just above
+        from cadgen.solids.bought_places import tapped_screws
         from cadgen.solids.extrude import manifold3d_engine
 
         m3d = manifold3d_engine()
         depth, radius = screwed["counterbore_depth"], screwed["counterbore_diameter"] / 2
+        floor = layout.cam_bottom + thickness - depth   # the counterbores' floor: the heads'
         for centre, _ in screws:
             solid = solid - m3d.Manifold.cylinder(depth + 1.0, radius, radius, segments).translate(
-                (centre[0], centre[1], layout.cam_bottom + thickness - depth))
-    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour)
+                (centre[0], centre[1], floor))
+        # the screws on that floor, down into the cover roof's tapped holes
+        bought = tuple(tapped_screws(screwed["bolt"], screwed["screw_length"],
+                                     [centre for centre, _ in screws], floor, up=False,
+                                     fitted=("gearbox2-cover",)))
+    return Part("cam", "cam", "gearbox2", solid, lambda phi: local0, outline=contour,
+                bought=bought)
 
 
 def _planter_parts(params, cam_design, layout, segments, hub=None, duckbill=None):
@@ -560,4 +601,5 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
         return poses(body, phi)
 
     return placed_assembly(parts, pose, planting_model, drivetrain, train,
-                           dict(zip(("gearbox1", "gearbox2", "frame"), housings))), housings, layout
+                           dict(zip(("gearbox1", "gearbox2", "frame"), housings)),
+                           segments=segments), housings, layout

@@ -209,7 +209,7 @@ def pricking_assembly(params, design, train, field, *, drivetrain=None, soil: bo
             params, field[0], (float(centre[0] - reach), float(centre[0] + reach)),
             (-floor, z_top), segments))
     assembly = placed_assembly(parts, body_pose, pricking_model, drivetrain, train,
-                               {"gear-case": case})
+                               {"gear-case": case}, segments=segments)
     assembly.prepare = prepare
     return assembly, {"gear-case": case}
 
@@ -270,8 +270,11 @@ def _rocker_and_needle(params, link, needle, *, z0, segments, hub=None, clamp=No
                                     segments).translate((link.rocker, 0.0, axis_z))
         rocker = rocker + holder - bore - tap
         back = width / 2   # the needle enters the holder at its back face
+        from cadgen.solids.bought_places import set_screw_item
+
+        bought = (set_screw_item(clamp, link.rocker, axis_z, ("needle",)),)
     else:
-        axis_z, back = z0 + linkage.rocker_thickness / 2, 0.0
+        axis_z, back, bought = z0 + linkage.rocker_thickness / 2, 0.0, ()
     length = link.needle + back
     shaft = m3d.Manifold.cylinder(length - cone, radius, radius, segments)
     point = m3d.Manifold.cylinder(cone, radius, 0.0, segments).translate((0, 0, length - cone))
@@ -279,7 +282,8 @@ def _rocker_and_needle(params, link, needle, *, z0, segments, hub=None, clamp=No
     # its back end behind the rocker's end by ``back``
     body = (shaft + point).rotate((-90.0 * needle.side, 0.0, 0.0))
     body = body.translate((link.rocker, -needle.side * back, axis_z))
-    return [Part("rocker", "rocker", "planet", rocker), Part("needle", "needle", "planet", body)]
+    return [Part("rocker", "rocker", "planet", rocker, bought=bought),
+            Part("needle", "needle", "planet", body)]
 
 
 def _stand_along_y(solid, length: float):

@@ -94,13 +94,9 @@ class _Shape:
     def model(self):
         """The mesh's ``fcl.BVHModel`` (built on first use: most parts never need it)."""
         if self._model is None:
-            import fcl
+            from cadgen.solids.contact import fcl_tree
 
-            model = fcl.BVHModel()
-            model.beginModel(len(self.faces), len(self.vertices))
-            model.addSubModel(self.vertices, self.faces)
-            model.endModel()  # without it the first query crashes
-            self._model = model
+            self._model = fcl_tree(self.vertices, self.faces)
         return self._model
 
     @property
@@ -111,12 +107,9 @@ class _Shape:
     def probes(self) -> np.ndarray:
         """One vertex of each closed surface (k, 3): containment is decided by one point each."""
         if self._probes is None:
-            import trimesh
+            from cadgen.solids.contact import surface_probes
 
-            adjacency = trimesh.graph.face_adjacency(faces=self.faces)
-            components = trimesh.graph.connected_components(adjacency,
-                                                            nodes=np.arange(len(self.faces)))
-            self._probes = np.array([self.vertices[self.faces[c[0], 0]] for c in components])
+            self._probes = surface_probes(self.vertices, self.faces)
         return self._probes
 
 

@@ -95,9 +95,10 @@ class PairScene(SweepScene, Protocol):
 
 
 def part_instances(assembly) -> dict:
-    """``{instance name: (part, body, phase)}`` of every placed copy, in assembly order."""
+    """``{instance name: (part, body, phase)}`` of every placed copy, in assembly order: the
+    made parts', then the bought solids' (``assembly.bought``, riding on the same bodies)."""
     out = {}
-    for part in assembly.parts:
+    for part in list(assembly.parts) + list(getattr(assembly, "bought", ())):
         for name, body, phase in part.instances or ((part.name, part.body, 0.0),):
             out[name] = (part, body, float(phase))
     return out
