@@ -289,6 +289,84 @@ def test_each_key_fills_its_keyseat_and_its_gears_keyway(planting):
                 assert (placed_key ^ placed_gear).volume() <= VOLUME_FLOOR, (key.name, gear.name)
 
 
+def test_each_ring_sits_in_its_groove_on_its_shafts_axis(planting):
+    """A DIN 471 ring rides with its shaft, coaxial, its bore on the groove's bottom: the
+    shaft's least radius over the ring's height is d2 / 2 of the standard's table (d 15: d2
+    14.3, s 1; d 20: 19, 1.2), and the ring is s thick; every shaft with a ring in its stack
+    has it as a solid."""
+    table = {15.0: (14.3, 1.0), 17.0: (16.2, 1.0), 20.0: (19.0, 1.2), 25.0: (23.9, 1.2),
+             30.0: (28.6, 1.5)}   # DIN 471: d1 -> (d2, s)
+    assembly = planting[1]["parts"].assembly
+    parts = {part.name: part for part in assembly.parts}
+    rings = [part for part in assembly.bought if part.kind == "retaining ring"]
+    held = planting[1]["drivetrain"].retention
+    # one ring solid per ring of each shaft part: a gearbox-2 shaft's two sides are one part,
+    # C2's are two (side 2 has its own, shaft-C2-arm2)
+    own = {(r.shaft + ("-arm2" if r.side == 2 and r.shaft == "C2" else ""), k)
+           for r in held for k in range(len(r.rings))}
+    assert len(rings) == len(own) > 5
+    for ring in rings:
+        shaft = parts[ring.host]
+        d1 = float(re.search(r"DIN 471 (\d+)", ring.designation).group(1))
+        d2, s = table[d1]
+        local = np.linalg.solve(shaft.local(0.3), ring.local(0.3))   # in the shaft's frame
+        np.testing.assert_allclose(local[:3, 2], [0.0, 0.0, 1.0], atol=1e-12)
+        np.testing.assert_allclose(local[:2, 3], [0.0, 0.0], atol=1e-9)
+        corners = ring.mesh.vertices @ local[:3, :3].T + local[:3, 3]
+        low, high = corners[:, 2].min(), corners[:, 2].max()
+        assert high - low == pytest.approx(s, abs=1e-9)
+        # the shaft's section through the ring's middle: the groove's bottom, no larger
+        section = np.vstack(shaft.solid.slice(0.5 * (low + high)).to_polygons())
+        assert np.hypot(*section.T).max() == pytest.approx(d2 / 2, abs=1e-6), ring.name
+        assert np.hypot(*corners[:, :2].T).min() == pytest.approx(d2 / 2, abs=1e-6)
+
+
+def test_a_set_screw_is_drilled_on_its_keyways_line_and_bears_on_the_keys_back(planting):
+    """A gear held by a set screw (ISO 4029, cup point): the screw's axis is radial along the
+    keyway's centre line in the middle of the face, its point at the key's back (DIN 6885:
+    d/2 - t1 + h from the axis: C 30 mm, key 8 x 7, t1 4: 18 mm), its thread in a tap-drilled
+    hole of the gear (ISO 2306: M5 4.2 mm) whose axis has no material, and its far end inside
+    the gear's outline."""
+    from cadgen.machine.catalogue import key_for_shaft
+    from cadgen.solids.extrude import manifold3d_engine
+
+    m3d = manifold3d_engine()
+    values = planting[1]
+    assembly, drivetrain = values["parts"].assembly, values["drivetrain"]
+    parts = {part.name: part for part in assembly.parts}
+    screws = [part for part in assembly.bought if part.kind == "set screw"]
+    assert {s.host for s in screws} == {"train-1-planet", "transmission-driven-gear"}
+    drills = {"M5": 4.2, "M6": 5.0}
+    names = {gear.replace(" ", "-"): gear for r in drivetrain.retention for gear, _ in r.set_screws}
+    for screw in screws:
+        gear = parts[screw.host]
+        shaft, mount = drivetrain.shaft_of_gear(names[gear.name])
+        key = key_for_shaft(shaft.diameter)
+        thread, length = re.search(r"(M\d+) x (\d+)", screw.designation).groups()
+        at = np.linalg.solve(gear.local(0.0), screw.local(0.0))   # in the gear's frame
+        axis, point = at[:3, 2], at[:3, 3]
+        assert axis[2] == pytest.approx(0.0, abs=1e-12)
+        assert point[2] == pytest.approx(mount.face_width / 2, abs=1e-9)
+        assert point[0] * axis[1] - point[1] * axis[0] == pytest.approx(0.0, abs=1e-9)  # radial
+        assert np.hypot(*point[:2]) == pytest.approx(
+            shaft.diameter / 2 - key.shaft_depth + key.height, abs=1e-9)
+        # the gear's material along the screw: none within the tap drill's radius, all round
+        # it just outside (the thread's), from the bore to the screw's far end
+        far = point + axis * float(length)
+
+        def rod(radius):
+            return m3d.Manifold.cylinder(float(length), radius, radius, 48).transform(
+                at[:3, :])
+
+        drill = drills[thread] / 2
+        assert (gear.solid ^ rod(drill - 0.02)).volume() < 1e-6, screw.name
+        shell = (gear.solid ^ rod(drill + 0.3)).volume()
+        assert shell == pytest.approx(math.pi * ((drill + 0.3) ** 2 - drill**2) * float(length),
+                                      rel=0.05), screw.name
+        outline = shapely.Polygon(gear.outline)
+        assert outline.contains(shapely.Point(*far[:2])), screw.name
+
+
 # ------------------------------------------------------------------ the overlap check's fits
 def _plate_and_screw(head_face: float, *, tapped: bool = False, fitted=("plate",)):
     """A 10 mm plate with an M6 hole (clearance, or a 5.0 mm tap drill through), an ISO 4762

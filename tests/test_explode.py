@@ -199,3 +199,23 @@ def test_the_glb_carries_the_offsets_in_its_nodes_and_the_page_copy_keeps_them(e
         assert {n: e["explode"] for n, e in nodes.items() if "explode" in e} == {
             n: e["explode"] for n, e in extras.items()}
     assert assembly_bytes(placed, "glb") != glb   # without extras: the file as it was
+
+
+def test_the_bought_solids_come_off_with_the_part_they_sit_in(exploded):
+    """A cover lifted off takes its bearings, dowels and flange screws with it; a shaft's keys
+    and rings come off with the shaft: each bought solid's offset is its host copy's, and
+    those in a moving host move (none is left floating where the assembly was)."""
+    from cadgen.export.meshes import _bought_offsets
+
+    _, assembly, _, _, offsets, _ = exploded
+    bought = _bought_offsets(assembly, offsets)
+    hosts = {part.name: part for part in assembly.parts}
+    moved = 0
+    for item in assembly.bought:
+        copies = hosts[item.host].instances or ((item.host, None, None),)
+        for (name, _, _), (host, _, _) in zip(item.instances, copies):
+            np.testing.assert_array_equal(bought[name], offsets[host])
+            moved += bool(np.any(offsets[host]))
+            if "-cover" in host:   # a cover lifts off: what sits in it goes with it
+                assert np.any(bought[name]), name
+    assert moved > 0

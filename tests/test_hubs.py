@@ -326,6 +326,26 @@ def test_hub_train_bores_every_carried_gear_once(pair):
     assert pair.profiles[0].hole is None          # the input train is left as it was
 
 
+@pytest.mark.parametrize("length, fails", [(6, False), (16, True)])
+def test_a_set_screw_standing_proud_of_its_gear_fails_the_hub_check(pair, length, fails):
+    """The pinion (24 teeth of module 2: root radius 21.5, tips 26) on a 20 mm shaft with a
+    6 x 6 key (t1 3.5): the key's back 10 - 3.5 + 6 = 12.5 mm out; an M5 x 6 screw ends at
+    18.5, inside the roots; an M5 x 16 at 28.5, past the tips."""
+    from cadgen.machine.retention import ShaftRetention
+
+    stage = GearStage("first", pair, None, (0.0, (0.0, 0.0)))
+    shaft = Shaft("C2", "gearbox 2", 1, (0, 0), 20.0, 18.0, False, 1.0, 1.0, 1.0,
+                  (mount("pinion", 20.0, KEY_20),), (), 0.0, 0.0)
+    screw = f"set screw ISO 4029 M5 x {length} - 45H"
+    held = ShaftRetention("C2", 1, (), (("pinion", screw),))
+    _, checks = hub_train(GearTrain((stage,)), Drivetrain("planting", (shaft,), {}, "machined",
+                                                          retention=(held,)))
+    codes = [p.code for p in checks[0].problems]
+    assert ("set_screw_proud" in codes) == fails and checks[0].passed == (not fails)
+    if fails:
+        assert screw in checks[0].problems[-1].message
+
+
 # --------------------------------------------------------------------------- files
 
 

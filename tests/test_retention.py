@@ -226,3 +226,40 @@ def test_a_ring_groove_removes_its_annulus_from_the_shaft(paper_drivetrain):
         by_hand = (math.pi / 4 * (record.outside**2 - record.bore**2)
                    * (record.z1 - record.z0) * polygon)
         assert part.solid.volume() == pytest.approx(by_hand, rel=1e-6)
+
+
+def _disc_profile(outline, keyway=0.0):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(outline=np.asarray(outline, dtype=float), centre=(0.0, 0.0),
+                           notes={"keyway_angle_rad": keyway})
+
+
+@pytest.mark.parametrize("radius, clearance", [(27.0, 1.0), (26.0, 0.0), (25.0, -1.0)])
+def test_a_hub_set_screw_reaches_the_keys_back_plus_its_length(radius, clearance):
+    """By hand: shaft 30, DIN 6885 key 8 x 7 (t1 4): the key's back 15 - 4 + 7 = 18 mm from the
+    axis; an M5 x 8 screw ends at 26 mm; a disc of radius R leaves R - 26."""
+    from types import SimpleNamespace
+
+    from cadgen.machine.catalogue import key_for_shaft
+    from cadgen.machine.hubs import set_screw_clearance
+
+    key = key_for_shaft(30.0)
+    assert (key.width, key.height, key.shaft_depth) == (8.0, 7.0, 4.0)
+    t = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
+    disc = _disc_profile(np.column_stack([radius * np.cos(t), radius * np.sin(t)]), 0.3)
+    got = set_screw_clearance(disc, SimpleNamespace(diameter=30.0), key,
+                              "set screw ISO 4029 M5 x 8 - 45H")
+    # the 720-gon's chord at 0.3 rad lies within R (1 - cos(pi / 720)) of the circle
+    assert got == pytest.approx(clearance, abs=radius * (1 - np.cos(np.pi / 720)) + 1e-12)
+
+
+def test_a_set_screw_on_a_tooths_line_meets_the_tip_and_in_a_space_the_root():
+    """A square 'gear' of half-width 30: along +x the ray leaves at 30, along the diagonal at
+    30 sqrt 2 (the corner): where the ray leaves the outline, not the outline's least radius."""
+    from cadgen.machine.hubs import outline_radius_along
+
+    square = [(30.0, -30.0), (30.0, 30.0), (-30.0, 30.0), (-30.0, -30.0)]
+    assert outline_radius_along(square, 0.0) == pytest.approx(30.0, abs=1e-12)
+    assert outline_radius_along(square, np.pi / 4) == pytest.approx(30.0 * np.sqrt(2), abs=1e-9)
+    assert outline_radius_along(square, 0.2) == pytest.approx(30.0 / np.cos(0.2), abs=1e-9)

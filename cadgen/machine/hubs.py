@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,7 +35,8 @@ from kinematics.errors import Problem
 
 __all__ = ["MIN_RIM_MODULES", "WARN_RIM_MODULES", "KEYWAY_ANGLE_STEPS", "KEYWAY_TIE_TOLERANCE",
            "RimCheck", "CuttingOutline", "hub_hole", "best_keyway_angle", "rim_thickness",
-           "rim_check", "hub_train", "cutting_outline"]
+           "rim_check", "hub_train", "cutting_outline", "outline_radius_along",
+           "set_screw_clearance"]
 
 #: Rim under the hole below this many modules fails (``rim_too_thin``): the common hard minimum
 #: of a gear's rim (one module), below which the rim cracks between the root and the bore.
@@ -330,6 +332,30 @@ def rim_check(profile, hole, *, path: str = "") -> RimCheck:
     return RimCheck(profile.name, thickness, limit, bool(passed), where, warning, module, problems)
 
 
+def outline_radius_along(outline, angle: float) -> float:
+    """mm: where the ray from the origin at ``angle`` (rad) first leaves ``outline`` (a closed
+    ring about the origin): a tooth's tip, or a tooth space's root."""
+    import shapely
+
+    ray = shapely.LineString([(0.0, 0.0), (1e4 * math.cos(angle), 1e4 * math.sin(angle))])
+    crossing = shapely.LinearRing(np.asarray(outline, dtype=float)).intersection(ray)
+    points = np.array([p.coords[0] for p in getattr(crossing, "geoms", [crossing])
+                       if not p.is_empty]).reshape(-1, 2)
+    return float(np.min(np.hypot(points[:, 0], points[:, 1])))
+
+
+def set_screw_clearance(profile, shaft, key, designation: str) -> float:
+    """mm between a hub set screw's far end and the gear's outline on the keyway's line (< 0:
+    the screw stands proud). The screw is radial on the keyway's centre line, its point on
+    the key's back (``d/2 - t1 + h`` from the axis), as long as its designation says
+    (``... M5 x 8 ...``)."""
+    length = float(re.search(r"M\d+ x (\d+(?:\.\d+)?)", designation).group(1))
+    back = shaft.diameter / 2 - key.shaft_depth + key.height
+    angle = float(profile.notes.get("keyway_angle_rad", 0.0))
+    outline = np.asarray(profile.outline, dtype=float) - np.asarray(profile.centre, dtype=float)
+    return outline_radius_along(outline, angle) - (back + length)
+
+
 # --------------------------------------------------------------------------- the train
 
 
@@ -357,6 +383,8 @@ def hub_train(train, drivetrain, *, key_slot_allowance: float = 0.0, segments: i
         One per distinct gear, in the train's order (see :class:`RimCheck`).
     """
     bored, checks = {}, []
+    screws = {gear: designation for held in getattr(drivetrain, "retention", ()) or ()
+              for gear, designation in held.set_screws}
     for profile, _, _, _ in train.gears:
         try:
             shaft, mount = drivetrain.shaft_of_gear(profile.name)
@@ -381,7 +409,17 @@ def hub_train(train, drivetrain, *, key_slot_allowance: float = 0.0, segments: i
                                     bore_radius=(mount.hub_bore + mount.bore_allowance) / 2,
                                     notes={**profile.notes, "keyway_angle_rad": float(angle)})
         bored[profile.name] = holed
-        checks.append(rim_check(holed, hole, path=f"machine.shafts.{shaft.name}"))
+        check = rim_check(holed, hole, path=f"machine.shafts.{shaft.name}")
+        screw = screws.get(profile.name)
+        if screw is not None and mount.key is not None:
+            proud = -set_screw_clearance(holed, shaft, mount.key, screw)
+            if proud > 0.0:   # its head among the mating teeth
+                check = dataclasses.replace(check, passed=False, problems=check.problems + (
+                    Problem(f"machine.shafts.{shaft.name}", "set_screw_proud",
+                            f"the {profile.name} gear's {screw} stands {proud:.2f} mm proud of "
+                            "the gear on its keyway's line, into the mating teeth: use a "
+                            "larger gear or a smaller shaft"),))
+        checks.append(check)
     stages = []
     for stage in train.stages:
         profiles = tuple(bored.get(p.name, p) for p in stage.generated.profiles)

@@ -21,9 +21,10 @@ PREDICTED_FINDINGS = frozenset({"undercut"})
 #: Gear-check codes that fail a design (read from a report written before problems carried
 #: their ``severity``); ``cadgen.gears.pairs.FAILING_PROBLEMS`` is the source.
 FAILING_GEAR_PROBLEMS = frozenset({"undercut_root_too_thin"})
-#: Rim checks of a gear's bore that fail the design; the others (a thin rim, a gear no shaft
-#: carries) are warnings (:mod:`cadgen.machine.hubs`).
-FAILING_RIM_PROBLEMS = frozenset({"rim_too_thin"})
+#: Rim checks of a gear's bore that fail the design (a rim too thin, a hub set screw standing
+#: proud among the mating teeth); the others (a thin rim, a gear no shaft carries) are
+#: warnings (:mod:`cadgen.machine.hubs`).
+FAILING_RIM_PROBLEMS = frozenset({"rim_too_thin", "set_screw_proud"})
 
 
 def input_hash(params) -> str:

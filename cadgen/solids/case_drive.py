@@ -57,9 +57,20 @@ def case_drive_parts(held: dict, sun_shaft, sun_part, centre, floor_wall: float,
               for xy in bracket["mount_holes"]]
     plate = extrude(square, bracket["plate_thickness"], holes=[bore, *mounts], z0=stub_bottom,
                     path="case_drive.bracket")
+    boss_bottom = stub_bottom + bracket["plate_thickness"]
     boss = extrude(circle(bracket["boss_diameter"] / 2, segments, tuple(centre)),
-                   bracket["boss_length"], holes=[bore], z0=stub_bottom + bracket["plate_thickness"],
+                   bracket["boss_length"], holes=[bore], z0=boss_bottom,
                    path="case_drive.bracket")
+    held_by = ()
+    if sun_shaft.coupling_key is not None:   # the set screw through the boss onto the key
+        from cadgen.machine.retention import set_screw
+        from cadgen.solids.retention_items import radial_set_screw
+
+        hole, screw = radial_set_screw(set_screw(sun_shaft.coupling_key), sun_shaft.diameter,
+                                       sun_shaft.coupling_key, keyway, centre,
+                                       boss_bottom + bracket["boss_length"] / 2,
+                                       bracket["boss_diameter"] / 2, segments)
+        boss, held_by = boss - hole, (screw,)
     # the screws' clearance holes (ISO 273 medium), where the case's tapped holes are
     hole = clearance_hole(sprocket["bolt"], "medium")
     screws = [circle(hole / 2, 24, (float(x), float(y)))
@@ -78,6 +89,7 @@ def case_drive_parts(held: dict, sun_shaft, sun_part, centre, floor_wall: float,
     screws = tapped_screws(sprocket["bolt"], None, bolt_circle(sprocket, tuple(centre)),
                            -floor_wall - sprocket["width"], up=True, clamped=sprocket["width"],
                            fitted=("gear-case-base",))
-    return [Part("frame-bracket", "housing", "frame", plate + boss, lambda angle: fixed),
+    return [Part("frame-bracket", "housing", "frame", plate + boss, lambda angle: fixed,
+                 bought=held_by),
             BoughtPart("case-sprocket", "sprocket", "case", wheel, lambda angle: fixed,
                        bought=tuple(screws), designation=sprocket_items(held)[0].designation)]

@@ -315,6 +315,7 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=(),
     hollow shaft's flange screws.
     """
     from cadgen.solids.bought_places import bearing_pair, key_item
+    from cadgen.solids.retention_items import ring_items
     from cadgen.solids.split_housing import shaft_solid
 
     z_bottom, z_top = shaft_ends(shaft, housing)
@@ -355,6 +356,7 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=(),
     solid = shaft_solid(shaft.diameter, z_bottom, z_top, keyseats=keyseats, flat_depth=flat,
                         flat_angle=flat_angle, segments=segments)
     solid = _ring_grooves(solid, shaft, retention, housing.z_cavity_bottom, segments)
+    bought += ring_items(shaft, retention, housing.z_cavity_bottom)
     if getattr(shaft, "bore", 0.0) > 0.0:
         solid = _hollow(solid, shaft, z_bottom, z_top, segments)
         bought += flange_screws(shaft.flange, z_top)

@@ -583,6 +583,11 @@ def planting_assembly(params, mechanism, train, cam_design, soil_level: float | 
     # the shafts turn with their gears, keyseats under the gears' keyways
     housing_parts, housings = _housing_parts(params, mechanism, circles, shells, layout, segments,
                                              drivetrain, frames)
+    if train is not None and train.stages:   # the gears a set screw holds: drilled, screwed
+        from cadgen.solids.retention_items import set_screw_gears
+
+        gear_parts = set_screw_gears(gear_parts, drivetrain,
+                                        {p.name: p for p, _, _, _ in train.gears}, segments)
     parts = housing_parts + gear_parts
     if cam_design is not None and cam_design.cuttable:
         parts.append(_cam_part(params, mechanism, cam_design, layout, segments, drivetrain))
