@@ -36,6 +36,7 @@ __all__ = [
     "solve_closure",
     "polar_perimeter",
     "polar_curvature",
+    "parametric_curvature",
     "refined_radius_extrema",
     "pair_problems",
     "centre_distance_at_nodes",
@@ -368,6 +369,21 @@ def polar_curvature(curve, t):
     """Signed curvature (1/mm) of ``rho = r(t)``; negative on concave stretches."""
     r, dr, ddr = curve.radius_derivatives(t)
     return (r**2 + 2 * dr**2 - r * ddr) / (r**2 + dr**2) ** 1.5
+
+
+def parametric_curvature(rho, d_rho, dd_rho, psi_rate, psi_rate2):
+    """Signed curvature (1/mm) of the pitch curve ``rho(v) u(psi(v))`` from its derivatives.
+
+    ``rho``, ``psi`` and their first and second derivatives along any parameter ``v`` (arrays
+    of one shape): the curve's ``x' y'' - y' x''`` over ``|p'|^3``, signed with ``psi'`` so
+    that a convex stretch is positive whichever way the parameter runs round the gear (a
+    driven gear's contact turns backwards). With ``psi = v`` it is :func:`polar_curvature`.
+    """
+    tangential = rho * psi_rate
+    speed = np.hypot(d_rho, tangential)
+    bend = (d_rho * (2 * d_rho * psi_rate + rho * psi_rate2)
+            - tangential * (dd_rho - rho * psi_rate**2))
+    return np.sign(psi_rate) * bend / speed**3
 
 
 def _finer_module(largest: float, path: str) -> str:

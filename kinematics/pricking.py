@@ -88,6 +88,19 @@ class PrickingDesign:
         functions = {name: from_dead_centre(f) for name, f in self.pitch_functions.items()}
         return functions, tuple(breaks[np.concatenate([[True], np.diff(breaks) > 0.0])])
 
+    def cycle_curvatures(self) -> dict:
+        """Each gear's signed pitch-curve curvature (1/mm, convex positive) at the contact over
+        the carrier cycle ``tau`` of :meth:`cycle_functions`: ``{name: tau -> curvature}``."""
+        shift, period = self.motion.v_max, self.motion.period
+
+        def from_dead_centre(function):
+            def shifted(tau):
+                v = np.mod(np.asarray(tau, dtype=float), period) + shift
+                return function(np.where(v >= period, v - period, v))
+            return shifted
+
+        return {name: from_dead_centre(f.curvature) for name, f in self.pitch_functions.items()}
+
 
 def _forward_check(motion, grid_phi1, grid_v, radii):
     """Rebuild the tip loop from the tabulated pitch curves alone, as a shop would.

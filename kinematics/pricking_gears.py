@@ -14,6 +14,7 @@ import numpy as np
 
 from .chebyshev import PiecewiseChebyshev
 from .errors import DesignError
+from .pitch_curves import parametric_curvature
 from .pricking_motion import TWO_PI, CarrierMotion
 from .scalar import brentq
 
@@ -245,10 +246,7 @@ def _gear_report(name, stage, role, geometry, constant, exponent, factor, grid_v
                                                                   factor)
     # curve rho(v) u(psi(v)): signed curvature, made positive where convex whatever the sense
     tangential = rho * psi_rate
-    speed = np.hypot(d_rho, tangential)
-    bend = (d_rho * (2 * d_rho * psi_rate + rho * psi_rate2)
-            - tangential * (dd_rho - rho * psi_rate**2))
-    curvature = np.sign(psi_rate) * bend / speed**3
+    curvature = parametric_curvature(rho, d_rho, dd_rho, psi_rate, psi_rate2)
     deviation = np.degrees(np.arctan2(np.abs(d_rho), np.abs(tangential)))
     concave = curvature < 0.0
     limit = module * (addendum - shift) / np.sin(pressure_angle) ** 2   # rack, profile shift x
@@ -322,13 +320,28 @@ def _pitch_functions(geometry, constant, exponent, factors, stage1_turn, total_t
     }
 
     period = geometry.motion.period
+    return {name: _ContactFunctions(geometry, period, *spec) for name, spec in specs.items()}
 
-    def make(c, e, role, factor, angle):
-        def functions(v):
-            v = np.asarray(v, dtype=float)
-            v = np.where((v < 0.0) | (v > period), np.mod(v, period), v)
-            rho, d_rho, _, psi_rate, _ = geometry.gear_curve(v, c, e, role, factor)
-            return rho, d_rho, angle(v), psi_rate
-        return functions
 
-    return {name: make(*spec) for name, spec in specs.items()}
+class _ContactFunctions:
+    """One gear's contact functions ``v -> (rho, drho, psi, dpsi)`` (called), and the signed
+    curvature of its pitch curve at the contact (:meth:`curvature`, from the closed-form second
+    derivatives: the tooth strength takes each gear as the spur gear of that curvature)."""
+
+    def __init__(self, geometry, period, constant, exponent, role, factor, angle):
+        self._geometry, self._period = geometry, period
+        self._spec = (constant, exponent, role, factor)
+        self._angle = angle
+
+    def _wrapped(self, v):
+        v = np.asarray(v, dtype=float)
+        return np.where((v < 0.0) | (v > self._period), np.mod(v, self._period), v)
+
+    def __call__(self, v):
+        v = self._wrapped(v)
+        rho, d_rho, _, psi_rate, _ = self._geometry.gear_curve(v, *self._spec)
+        return rho, d_rho, self._angle(v), psi_rate
+
+    def curvature(self, v):
+        """Signed curvature (1/mm) of the pitch curve at the contact, convex positive."""
+        return parametric_curvature(*self._geometry.gear_curve(self._wrapped(v), *self._spec))

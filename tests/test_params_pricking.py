@@ -217,8 +217,9 @@ def test_example_comments_name_every_quantity(path):
         assert "#" in stripped, line  # key = value lines and the point lines
         checked += 1
     # top level 2; [trajectory] 15 (points = [, 12 points, degree, sun_centre); [linkage] 1;
-    # [gears] 7; [field] 4; [resolution] 1; [machine] 6; [manufacturing] 2
-    assert checked == 2 + 15 + 1 + 7 + 4 + 1 + 6 + 2
+    # [gears] 7; [field] 4; [resolution] 1; [machine] 8 (the tooth safety limits too);
+    # [manufacturing] 2
+    assert checked == 2 + 15 + 1 + 7 + 4 + 1 + 8 + 2
     assert "mirror" in text.lower()  # the header says the spec's points are mirrored in x
     assert "assumed" in text  # the forward speed is an assumption, not the paper's
 

@@ -49,6 +49,8 @@ class GearTrain:
     # train 1's parallel sets (planting): their ratios and each mesh's axis distance
     sets: tuple = ()       # ({"name", "key", "converted_ratio", "axes": (O, A, B, C)}, ...)
     drive: object = None   # cadgen.gears.drive.DriveDesign of the frame's two pairs (planting)
+    # cadgen.gears.strength_summary.TrainStrength: every gear's tooth strength over the cycle
+    strength: object = None
     # the gear cache the train was cut with (or None): its files are looked up there too
     cache: object = field(default=None, repr=False, compare=False)
 
@@ -351,6 +353,8 @@ def train_report(train: GearTrain) -> dict:
                          for c, m in check.problems],
             "outline_points": int(len(profile.outline)),
         })
+        if train.strength is not None and profile.name in train.strength.gears:
+            gears[-1].update(train.strength.gears[profile.name].as_dict())
     meshes = [{
         "stage": s.name, "gears": list(s.generated.pair.names),
         "centre_distance_mm": s.generated.pair.centre_distance,
@@ -372,6 +376,10 @@ def train_report(train: GearTrain) -> dict:
         out["sets"] = [set_report(train, record) for record in train.sets]
     if train.drive is not None:
         out["drive"] = train.drive.as_report()
+    if train.strength is not None:
+        from cadgen.gears.strength_summary import strength_report
+
+        out["strength"] = strength_report(train.strength)
     return out
 
 

@@ -76,6 +76,16 @@ class MachineParameters(_Table):
         150.0, gt=0, le=1000, description="allowed bearing pressure on a key's flank, MPa")
     bearing_life_min_h: float = Field(
         5000.0, gt=0, le=1e7, description="basic rating life L10 every bearing must reach, h")
+    bending_safety_min: float = Field(
+        1.4, ge=1, le=10,
+        description="least tooth-root bending safety S_F every gear must keep over the cycle "
+                    "(ISO 6336-3; 1.4 is the usual minimum for industrial gears, as in ISO/TR "
+                    "6336-30's examples), dimensionless")
+    contact_safety_min: float = Field(
+        1.0, ge=0.5, le=10,
+        description="least flank contact (pitting) safety S_H every gear must keep over the "
+                    "cycle (ISO 6336-2; 1.0: some pitting tolerated, the usual minimum for "
+                    "slow, non-critical drives), dimensionless")
     shafts: ShaftDiameters = ShaftDiameters()
 
 

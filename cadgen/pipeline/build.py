@@ -274,6 +274,11 @@ def _teeth(run):
             from cadgen.pipeline.gear_cache import remember_cutting_outlines
 
             remember_cutting_outlines(train, params.gears.chord_tolerance)
+    if train.stages:   # every cut gear's teeth under the design load over the cycle
+        from cadgen.machine.gear_strength import train_strength
+
+        train = dataclasses.replace(train, strength=train_strength(
+            params, run.values["kinematics"], train))
     return train
 
 

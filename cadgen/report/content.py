@@ -324,6 +324,8 @@ def check_warnings(report: dict) -> list:
             if not _gear_problem_fails(problem):
                 out.append({"check": "gear checks", "path": f"gears.{gear['gear']}",
                             "code": problem["code"], "message": problem["message"]})
+    for problem in gear_train.get("strength", {}).get("warnings", []):
+        out.append({"check": "tooth strength", **problem})
     for rim in report.get("machine", {}).get("hubs", []):
         for problem in rim["problems"]:
             if problem["code"] not in FAILING_RIM_PROBLEMS:

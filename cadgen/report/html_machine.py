@@ -349,3 +349,43 @@ def bom_section_html(report: dict) -> str:
                       "quantity", "mass each (kg)", "file"], table, numeric=(0, 6, 7)))
     return _section("bom", "Bill of materials", body, folded=True,
                     gist=f"{made} made and {bought} bought parts")
+
+
+def _strength_html(train: dict) -> str:
+    """The teeth's strength over the cycle: each gear's least bending and contact safety,
+    where, against the ``[machine]`` limits; the load it was computed for and the method."""
+    strength = train.get("strength")
+    if not strength:
+        return ""
+    limits = strength["limits"]
+    rows, classes = [], []
+    for g in train.get("gears", []):
+        if "bending_safety_min" not in g:
+            continue
+        contact = g.get("contact_safety_min")
+        low = (g["bending_safety_min"] < limits["bending_safety_min"]
+               or (contact is not None and contact < limits["contact_safety_min"]))
+        rows.append([_e(g["gear"]), _e(g["material"]),
+                     _e(_number(g["equivalent_teeth_min"], 2)),
+                     _e(_number(g["root_stress_max_mpa"], 0)),
+                     _e(_number(g["bending_safety_min"], 2)),
+                     _e(f"{g['bending_safety_mesh']}, {_number(g['bending_safety_at_deg'], 1)}°"),
+                     _e(_number(g["contact_stress_max_mpa"], 0)),
+                     _e("not rated" if contact is None else _number(contact, 2)),
+                     _e("—" if contact is None else
+                        f"{g['contact_safety_mesh']}, {_number(g['contact_safety_at_deg'], 1)}°"),
+                     _e(str(g["strength_invalid_poses"]))])
+        classes.append("fail" if low else "")
+    factors = ", ".join(f"{k} {_number(v, trim=True)}" for k, v in strength["factors"].items())
+    text = (f"Least safeties over each gear's meshes and poses against machine.bending_safety_min "
+            f"= {_number(limits['bending_safety_min'], trim=True)} and "
+            f"machine.contact_safety_min = {_number(limits['contact_safety_min'], trim=True)}. "
+            f"Load: {strength['load']}. Method: {strength['method']}; load factors {factors}.")
+    return ("<h3>Tooth strength over the cycle</h3><p>" + _e(text) + "</p>"
+            + _table(["gear", "material", "least z_v", "root stress max (MPa)", "S_F min",
+                      "where (mesh, cycle angle)", "Hertz stress max (MPa)", "S_H min",
+                      "where (mesh, cycle angle)", "poses outside validity"], rows,
+                     numeric=(2, 3, 4, 6, 7, 9), row_classes=classes)
+            + _problem_list(strength.get("problems", []))
+            + _problem_list(strength.get("warnings", []), "warn"))
+

@@ -280,6 +280,9 @@ def _gears_section(report: dict) -> str:
              "largest overlap (mm²)", "backlash (deg)", "transmission error p-p (deg)",
              "tip relief"],
             mesh_rows, numeric=(2, 3, 4, 5, 6), row_classes=classes))
+    from cadgen.report.html_machine import _strength_html
+
+    body.append(_strength_html(train))
     return _section("gears", "Gears", "".join(body), gist=verdict.statement())
 
 

@@ -330,4 +330,27 @@ def format_gear_table(gear_train: dict, report: dict | None = None) -> str:
         meshes.append(f"NOT CUT [{f['code']}] {f['message']}")
     if meshes:
         lines += [""] + meshes
+    strength = gear_train.get("strength")
+    if strength:
+        lines += ["", _strength_line(gear_train["gears"], strength)]
     return "\n".join(lines)
+
+
+def _strength_line(gears: list, strength: dict) -> str:
+    """One line: the least bending and contact safeties of the train, whose, against the
+    limits, and the load they are for."""
+    rated = [g for g in gears if "bending_safety_min" in g]
+    if not rated:
+        return "tooth strength: no gear rated"
+    limits = strength["limits"]
+    bending = min(rated, key=lambda g: g["bending_safety_min"])
+    contacts = [g for g in rated if g.get("contact_safety_min") is not None]
+    text = (f"tooth strength ({strength['load'].split(':')[0]}): least bending safety "
+            f"{bending['bending_safety_min']:.2f} ({bending['gear']}; limit "
+            f"{limits['bending_safety_min']:g})")
+    if contacts:
+        contact = min(contacts, key=lambda g: g["contact_safety_min"])
+        text += (f", least contact safety {contact['contact_safety_min']:.2f} "
+                 f"({contact['gear']}; limit {limits['contact_safety_min']:g})")
+    low = len(strength.get("problems", []))
+    return text + (f"; {low} checks below their limits" if low else "")
