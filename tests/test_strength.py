@@ -260,3 +260,30 @@ def test_the_pricking_pitch_curvature_against_the_cut_curves():
             exact = curvatures[name](tau)
             assert exact.min() == pytest.approx(spline.min(), rel=2e-3, abs=1e-5)
             assert exact.max() == pytest.approx(spline.max(), rel=2e-3)
+
+
+def test_a_gear_below_its_limit_fails_the_build_and_the_gear_material_names_the_allowables():
+    """A strength problem fails the verdict; ``[machine] gear_material`` sets the allowables
+    (ISO 6336-5 MQ: 42CrMo4+QT at 300 HV, sigma_Hlim = 1.313 x 300 + 373 = 766.9 MPa against
+    C45+N's 0.925 x 190 + 360 = 535.75) and the bill's and the masses' material."""
+    from cadgen.machine.fits import FitError, design_fits, process_fits
+    from cadgen.report.content import failures
+
+    problem = {"path": "machine.contact_safety_min", "code": "contact_safety",
+               "message": "input gear 2: S_H 0.74 below 1.0"}
+    said = failures({"gear_train": {"strength": {"problems": [problem]}}})
+    assert said == ["tooth strength: [contact_safety] input gear 2: S_H 0.74 below 1.0"]
+    assert gear_material("steel 42CrMo4+QT").contact_endurance == pytest.approx(766.9)
+    assert gear_material("steel C45").contact_endurance == pytest.approx(535.75)
+    assert process_fits("machined", "steel 42CrMo4+QT").material("gear").name == \
+        "steel 42CrMo4+QT"
+    assert process_fits("printed", "PA12").material("gear").density == 1010.0
+    assert process_fits("machined").material("gear").name == "steel C45"
+    with pytest.raises(FitError, match="gear material 'bronze'"):
+        process_fits("machined", "bronze")
+    from types import SimpleNamespace
+    params = SimpleNamespace(manufacturing=SimpleNamespace(process="laser"),
+                             machine=MachineParameters(gear_material="PETG"))
+    assert design_fits(params).material("gear").process == "laser-cut plate"
+    assert set(GEAR_MATERIALS) == set(MachineParameters.model_fields["gear_material"]
+                                      .annotation.__args__[0].__args__)

@@ -112,7 +112,7 @@ GEAR_MATERIALS = {m.name: m for m in (
            f"{_ISO}, through-hardened carbon steel V, C45+N at 190 HV"),
     _steel("steel S355", 150.0, (1.000, 190.0), (0.455, 69.0),
            f"{_ISO} (ML/MQ), normalised low-carbon wrought steel St, S355 at 150 HBW"),
-    _steel("steel 42CrMo4", 300.0, (1.313, 373.0), (0.425, 187.0),
+    _steel("steel 42CrMo4+QT", 300.0, (1.313, 373.0), (0.425, 187.0),
            f"{_ISO}, through-hardened alloy steel V, 42CrMo4+QT at 300 HV"),
     GearMaterial("aluminium EN AW-7075", 159.0, None, 71700.0, 0.33, 1.0,
                  "indicative: sigma_FE = rotating-bending fatigue strength at 5e8 cycles of "

@@ -13,12 +13,14 @@ the made parts. Machined features sit at the middle of their ISO tolerance zone
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
 __all__ = ["FitError", "SIZE_STEPS", "tolerance_grade", "deviation", "mean_deviation",
-           "Material", "ProcessFits", "process_fits", "PART_KINDS"]
+           "Material", "ProcessFits", "process_fits", "design_fits", "GEAR_MATERIAL_DENSITY",
+           "PART_KINDS"]
 
 
 class FitError(ValueError):
@@ -273,10 +275,35 @@ _PROCESSES = {
 }
 
 
-def process_fits(process: str) -> ProcessFits:
-    """The :class:`ProcessFits` of ``process`` (``printed``, ``machined``, ``laser`` or ``edm``)."""
+#: The gears' materials a design may name (``[machine] gear_material``) and their densities
+#: (kg/m^3; steels 7850, EN AW-7075 2810 and EN AW-6082 2700 from their data sheets, PETG 1270,
+#: sintered PA12 1010).
+GEAR_MATERIAL_DENSITY = {"steel C45": 7850.0, "steel S355": 7850.0, "steel 42CrMo4+QT": 7850.0,
+                         "aluminium EN AW-7075": 2810.0, "aluminium EN AW-6082": 2700.0,
+                         "PETG": 1270.0, "PA12": 1010.0}
+
+
+def process_fits(process: str, gear_material: str | None = None) -> ProcessFits:
+    """The :class:`ProcessFits` of ``process`` (``printed``, ``machined``, ``laser`` or ``edm``),
+    its gears of ``gear_material`` (one of :data:`GEAR_MATERIAL_DENSITY`) when named, made by
+    the process's own word."""
     try:
-        return _PROCESSES[process]
+        fits = _PROCESSES[process]
     except KeyError:
         raise FitError(f"manufacturing process {process!r} is not one of "
                        f"{', '.join(_PROCESSES)}") from None
+    if gear_material is None or gear_material == fits.materials["gear"].name:
+        return fits
+    if gear_material not in GEAR_MATERIAL_DENSITY:
+        raise FitError(f"gear material {gear_material!r} is not one of "
+                       f"{', '.join(GEAR_MATERIAL_DENSITY)}")
+    gear = Material(gear_material, GEAR_MATERIAL_DENSITY[gear_material],
+                    fits.materials["gear"].process)
+    return dataclasses.replace(fits, materials={**fits.materials, "gear": gear})
+
+
+def design_fits(params) -> ProcessFits:
+    """The fits and materials of a design: its process's, its gears of ``[machine]
+    gear_material`` when it names one."""
+    return process_fits(params.manufacturing.process,
+                        getattr(getattr(params, "machine", None), "gear_material", None))

@@ -181,6 +181,6 @@ def train_strength(params, design, train, mesh_forces: dict | None = None,
 
 
 def _process_material(params) -> str:
-    from cadgen.machine.fits import process_fits
+    from cadgen.machine.fits import design_fits
 
-    return process_fits(params.manufacturing.process).material("gear").name
+    return design_fits(params).material("gear").name

@@ -76,6 +76,12 @@ class MachineParameters(_Table):
         150.0, gt=0, le=1000, description="allowed bearing pressure on a key's flank, MPa")
     bearing_life_min_h: float = Field(
         5000.0, gt=0, le=1e7, description="basic rating life L10 every bearing must reach, h")
+    gear_material: Literal["steel C45", "steel S355", "steel 42CrMo4+QT", "aluminium EN AW-7075",
+                           "aluminium EN AW-6082", "PETG", "PA12"] | None = Field(
+        None, description="the gears' material, when not the process's (machined and edm: "
+                          "steel C45, normalised; laser: S355 plate; printed: PETG): "
+                          "its allowables set the teeth's bending and contact strength, its "
+                          "density the masses, and the bill names it")
     bending_safety_min: float = Field(
         1.4, ge=1, le=10,
         description="least tooth-root bending safety S_F every gear must keep over the cycle "

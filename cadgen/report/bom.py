@@ -91,9 +91,9 @@ def bom_rows(solids_outcome, solids_report: dict, drivetrain, params) -> list:
         None: no bought parts are listed (the machine design did not run).
     params : validated parameters (``manufacturing.process``).
     """
-    from cadgen.machine.fits import process_fits
+    from cadgen.machine.fits import design_fits
 
-    fits = process_fits(params.manufacturing.process)
+    fits = design_fits(params)
     rows = _made_rows(solids_report, fits)
     model = getattr(solids_outcome.assembly, "model", None)
     if drivetrain is not None and model is not None:

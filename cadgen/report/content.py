@@ -204,12 +204,12 @@ def machine_section(params, drivetrain, train=None) -> dict:
     """Shafts, bearings, keys and fits (:func:`cadgen.machine.drivetrain.drivetrain_report`),
     the process's allowances and materials, and each gear's rim under its bore."""
     from cadgen.machine.drivetrain import drivetrain_report
-    from cadgen.machine.fits import process_fits
+    from cadgen.machine.fits import design_fits
 
     from cadgen.machine.retention import retention_report
 
     section = drivetrain_report(drivetrain)
-    section["fits"] = process_fits(params.manufacturing.process).as_dict()
+    section["fits"] = design_fits(params).as_dict()
     section["retention"] = retention_report(getattr(drivetrain, "retention", ()) or ())
     rims = []
     for rim in (train.rims if train is not None else ()):
@@ -280,6 +280,8 @@ def failures(report: dict) -> list:
     machine = report.get("machine", {})
     for problem in machine.get("problems", []):
         out.append(f"machine: [{problem['code']}] {problem['message']}")
+    for problem in report.get("gear_train", {}).get("strength", {}).get("problems", []):
+        out.append(f"tooth strength: [{problem['code']}] {problem['message']}")
     for rim in machine.get("hubs", []):
         for problem in rim["problems"]:
             if problem["code"] in FAILING_RIM_PROBLEMS:

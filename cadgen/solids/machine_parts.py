@@ -25,7 +25,8 @@ from cadgen.solids.parts import Part, planar_transform
 
 __all__ = ["BOLT_BY_WALL", "housing_bolt", "stack_housing", "with_dowels", "dowel_positions",
            "housing_parts",
-           "printed_housing_parts", "printer_cuts", "shaft_part", "shaft_ends", "spacer_parts"]
+           "printed_housing_parts", "printer_cuts", "shaft_part", "shaft_ends", "spacer_parts",
+           "keyseat_turns", "side2_shaft", "SAME_KEYSEAT_RAD"]
 
 #: The bolt of a housing's flange from its side wall (mm): ``(wall below, size)``, else M6.
 BOLT_BY_WALL = ((4.0, "M3"), (6.0, "M4"), (8.0, "M5"))
@@ -367,6 +368,27 @@ def shaft_part(shaft, housing, body: str, *, segments: int, gears=None, hubs=(),
         def local(phi, first=first, offset=offset):
             return planar_transform(_turn_of(first(phi)), offset)
     return Part(f"shaft-{shaft.name}", "shaft", body, solid, local, bought=tuple(bought))
+
+
+#: rad: side 2's keyseats within this of side 1's are cut alike (one shaft part for both).
+SAME_KEYSEAT_RAD = 1e-6
+
+
+def side2_shaft(shaft, housing, retention, side1, side2, segments: int) -> list:
+    """Side 2's own copy of a carrier-1 shaft whose keyseats are phased otherwise than side
+    1's (``side1``, ``side2``: its gears' placements and keyways seen from ``carrier1`` and
+    from ``carrier1:mirrored``, as :func:`shaft_part`'s ``gears``). C2 is one: planet I turns
+    with side 2 about O, arm 2's central gear does not. Named ``shaft-<axis>-arm2``, placed
+    on ``carrier1:mirrored``; none when side 1's part fits both sides."""
+    from dataclasses import replace
+
+    one, two = keyseat_turns(shaft, side1), keyseat_turns(shaft, side2)
+    apart = [abs(math.remainder(two[name] - one[name], 2 * math.pi)) for name in one]
+    if max(apart, default=0.0) <= SAME_KEYSEAT_RAD:
+        return []
+    part = shaft_part(shaft, housing, "carrier1:mirrored", segments=segments, gears=side2,
+                      retention=retention)
+    return [replace(part, name=f"{part.name}-arm2")]
 
 
 def flange_screws(flange, z_top: float) -> list:

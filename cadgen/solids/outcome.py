@@ -46,6 +46,7 @@ class SolidsOutcome:
     build_volume: tuple = DEFAULT_BUILD_VOLUME   # mm (x, y, z), the printer's
     process: str = "machined"                    # [manufacturing] process: parts' materials
     segments: int = 96                           # polygons per circle (the overlaps' chord)
+    gear_material: str | None = None             # [machine] gear_material, else the process's
     _poses: dict = field(default_factory=dict, repr=False)
     _overhangs: dict = field(default_factory=dict, repr=False)   # printed parts' (mm^2)
     _printed: dict = field(default_factory=dict, repr=False)   # part name -> printing mesh
@@ -77,7 +78,8 @@ class SolidsOutcome:
         from cadgen.machine.fits import FitError, process_fits
 
         try:
-            return process_fits(self.process).material(part.kind).process == "printed"
+            return process_fits(self.process, self.gear_material).material(
+                part.kind).process == "printed"
         except FitError:   # not a made part (the soil, a bought sprocket)
             return False
 
@@ -100,7 +102,8 @@ def solids_outcome(params, assembly, housings) -> SolidsOutcome:
     return SolidsOutcome(assembly, housings, enclosure_checks(assembly, housings),
                          settings.assembly_carrier_angle_rad, settings.density_kg_m3,
                          settings.assembly_format, tuple(params.manufacturing.build_volume),
-                         params.manufacturing.process, settings.segments_per_circle)
+                         params.manufacturing.process, settings.segments_per_circle,
+                         getattr(getattr(params, "machine", None), "gear_material", None))
 
 
 def _turn_onto(normal) -> np.ndarray:
@@ -392,7 +395,7 @@ def _solids_report(outcome: SolidsOutcome) -> dict:
     parts = []
     too_big = []
     total = 0.0
-    materials = process_fits(outcome.process)
+    materials = process_fits(outcome.process, outcome.gear_material)
     for part in outcome.assembly.parts:
         instances = part.instances or ((part.name, part.body, 0.0),)
         if part.kind in _NOT_MADE:

@@ -61,8 +61,6 @@ __all__ = ["PlantingLayout", "planting_assembly", "cam_bore_radius", "GEARLESS_K
 #: drivetrain's stacks, not from the gears' outlines. Not the gears, not the shafts (each
 #: keyseat turns to its gear's keyway). A build sweeps the gearless assembly beside the teeth
 #: and takes these parts' meshes from it (:mod:`cadgen.pipeline.beside`).
-#: rad: side 2's keyseats within this of side 1's are cut alike (one shaft part for both).
-SAME_KEYSEAT_RAD = 1e-6
 GEARLESS_KINDS = frozenset({"housing", "planter", "blade", "cam", "ground", "lever", "push-rod",
                             "link"})
 
@@ -283,8 +281,8 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     """Both gearboxes as split housings (base and cover), and every shaft of the drivetrain."""
     from dataclasses import replace
 
-    from cadgen.solids.machine_parts import (printed_housing_parts, shaft_part, spacer_parts,
-                                             stack_housing)
+    from cadgen.solids.machine_parts import (printed_housing_parts, shaft_part, side2_shaft,
+                                             spacer_parts, stack_housing)
 
     a, r = mechanism.centre_distance, mechanism.r
     radius = {(c.gearbox, c.point): c.radius for c in circles}
@@ -339,7 +337,8 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
                           gears=_frames_for(gears, body), hubs=hubs, retention=stack)
         parts += [part] + spacer_parts(part, stack, housing.z_cavity_bottom, segments)
         if body == "carrier1":
-            parts += _side2_shaft(shaft, housing, stack, gears, segments)
+            parts += side2_shaft(shaft, housing, stack, _frames_for(gears, "carrier1"),
+                                 _frames_for(gears, "carrier1:mirrored"), segments)
     housings = (housing1, housing2)
     if "frame" in drivetrain.stacks:
         frame, frame_parts = _frame_parts(params, mechanism, drivetrain, layout, segments, gears)
@@ -348,24 +347,6 @@ def _housing_parts(params, mechanism, circles, shells, layout, segments, drivetr
     return parts, housings
 
 
-
-
-def _side2_shaft(shaft, housing, stack, gears, segments) -> list:
-    """Side 2's own copy of a carrier-1 shaft whose keyseats are phased otherwise than side
-    1's (C2: planet I turns with side 2 about O, arm 2's central gear does not), named
-    ``shaft-<axis>-arm2`` and placed on ``carrier1:mirrored``; none when side 1's fits."""
-    from dataclasses import replace
-
-    from cadgen.solids.machine_parts import keyseat_turns, shaft_part
-
-    side1 = keyseat_turns(shaft, _frames_for(gears, "carrier1"))
-    side2 = keyseat_turns(shaft, _frames_for(gears, "carrier1:mirrored"))
-    apart = [abs(math.remainder(side2[name] - side1[name], 2 * math.pi)) for name in side1]
-    if max(apart, default=0.0) <= SAME_KEYSEAT_RAD:
-        return []
-    part = shaft_part(shaft, housing, "carrier1:mirrored", segments=segments,
-                      gears=_frames_for(gears, "carrier1:mirrored"), retention=stack)
-    return [replace(part, name=f"{part.name}-arm2")]
 
 
 def _frame_parts(params, mechanism, drivetrain, layout, segments, gears):
