@@ -56,6 +56,12 @@ _NODE_STEMS = (
     ("dowel pin", r"ISO 8734 (\d+) x (\d+) - A - St$", "dowel-{0}x{1}"),
     ("set screw", r"ISO 402[79] (M\d+) x (\d+) - 45H$", "set-screw-{0}x{1}"),
     ("retaining ring", r"DIN 471 (\d+) x [\d.]+$", "ring-471-{0}"),
+    ("clevis pin", r"ISO 2341 B (\d+) x (\d+) - St$", "clevis-pin-{0}x{1}"),
+    ("washer", r"ISO 8738 (\d+) - 160 HV$", "washer-8738-{0}"),
+    ("split pin", r"ISO 1234 ([\d.]+) x (\d+) - St$", "split-pin-{0}x{1}"),
+    ("parallel pin", r"ISO 2338 (\d+) m6 x (\d+) - St$", "parallel-pin-{0}x{1}"),
+    ("compression spring", r"EN 13906-1 ([\d.]+) x ([\d.]+) x [\d.]+ n[\d.]+$",
+     "spring-{0}x{1}"),
 )
 
 

@@ -5,7 +5,7 @@ catalogues (:mod:`cadgen.machine.catalogue`); a size outside a table is a
 :class:`~cadgen.machine.catalogue.CatalogueError` naming the value and what the table holds.
 
 * ISO 2341 form B clevis pins (head, split-pin hole) with their ISO 8738 washers and ISO 1234
-  split pins: the linkage's hinge pins;
+  split pins (their legs' and eye's sizes): the linkage's hinge pins;
 * DIN 471 retaining rings (only the small shafts the linkage uses; kept apart from the
   machine's own ring tables so the two can grow separately);
 * deep-groove ball bearings of the 60, 62, 63 and 69 series small enough to run as a cam roller
@@ -19,7 +19,7 @@ import math
 
 from cadgen.machine.catalogue import CatalogueError, _rows
 
-__all__ = ["clevis_pin", "clevis_pin_length", "retaining_ring", "roller_bearing",
+__all__ = ["clevis_pin", "clevis_pin_length", "split_pin", "retaining_ring", "roller_bearing",
            "roller_bearings", "spring_wires", "PIN_LENGTHS", "SPLIT_PIN_LENGTHS"]
 
 #: The nominal lengths of ISO 2338 parallel pins and ISO 2341 clevis pins (mm), one series.
@@ -65,10 +65,21 @@ def clevis_pin_length(d: float, grip: float) -> dict:
                              f"longest is {pin['lengths'][-1]:g} mm)")
     # a split pin about twice the pin's diameter long bends round it
     split = next(v for v in SPLIT_PIN_LENGTHS if v >= 2 * d - 1e-9)
-    return {**pin, "length": length, "needed_length": needed,
+    return {**pin, "length": length, "needed_length": needed, "split_length": split,
             "pin": f"ISO 2341 B {d:g} x {length:g} - St",
             "washer": f"ISO 8738 {d:g} - 160 HV",
             "split": f"ISO 1234 {pin['split_pin']:g} x {split:g} - St"}
+
+
+def split_pin(nominal: float) -> dict:
+    """ISO 1234 split pin of ``nominal`` size (the hole it goes through, mm): ``{nominal, d_max
+    (its two legs together), c_max (its eye), b, a_max}``."""
+    for row in _rows("split_pins"):
+        if abs(float(row["nominal"]) - float(nominal)) < 1e-9:
+            return _float_row(row)
+    sizes = ", ".join(row["nominal"] for row in _rows("split_pins"))
+    raise CatalogueError(f"no ISO 1234 split pin of {float(nominal):g} mm in the table (it holds "
+                         f"{sizes})")
 
 
 def retaining_ring(shaft: float) -> dict:

@@ -16,12 +16,20 @@ balls and seals of a bearing):
 ``socket head cap screw``
     ``d``, ``length`` l, ``head_diameter`` dk, ``head_height`` k (ISO 4762): the head ``z`` 0
     to k, the shank ``z`` -l to 0 (the origin is the head's bearing face on the axis).
+``clevis pin``
+    ``d``, ``length`` l, ``head_diameter`` dk, ``head_height`` k (ISO 2341 B): as a screw, the
+    head ``z`` 0 to k, the shank ``z`` -l to 0 (its split-pin hole left out).
+``split pin``
+    ``d`` (its legs together, max), ``c`` (its eye, max), ``length`` l (ISO 1234): the legs a
+    cylinder ``z`` -l to 0, the eye a block c wide along ``x``, c high, d thick along ``y``
+    (``y`` along the pin it goes through).
 ``hexagon nut``
     ``d``, ``s`` (across flats), ``m`` (height) (ISO 4032): a hexagonal prism ``z`` 0 to m, a
     corner on +x, bored to d.
-``plain washer``
-    ``d1`` (hole), ``d2`` (outside), ``h`` (ISO 7089): a ring ``z`` 0 to h.
-``dowel pin``, ``pin``
+``plain washer``, ``washer``
+    ``d1`` (hole), ``d2`` (outside), ``h`` (ISO 7089; ISO 8738 for a clevis pin's): a ring
+    ``z`` 0 to h.
+``dowel pin``, ``pin``, ``parallel pin``
     ``diameter``, ``length`` (ISO 8734, ISO 2338): a cylinder ``z`` 0 to length.
 ``set screw``
     ``d``, ``length``, ``point`` (``"cone"``, the default, ISO 4027: a 90 degree cone point;
@@ -29,8 +37,9 @@ balls and seals of a bearing):
     the point's end at z = 0.
 ``retaining ring``
     ``inner``, ``outer``, ``thickness`` (DIN 471/472): a thin ring ``z`` 0 to thickness.
-``spring``
-    ``outside``, ``wire``, ``length``: the coil's envelope, a tube one wire thick.
+``spring``, ``compression spring``
+    ``outside``, ``wire``, ``length``: the coil's envelope, a tube one wire thick (EN 13906-1's
+    outside diameter D + d, its length as installed).
 ``roller``
     ``outside``, ``width``, ``bore`` (0: solid): a ring or a disc ``z`` 0 to width.
 
@@ -47,8 +56,9 @@ import numpy as np
 from cadgen.solids.bought import register_maker
 from cadgen.solids.outline import circle
 
-__all__ = ["ring", "bearing", "parallel_key", "socket_head_cap_screw", "hexagon_nut",
-           "plain_washer", "pin", "set_screw", "retaining_ring", "spring", "roller"]
+__all__ = ["ring", "bearing", "parallel_key", "socket_head_cap_screw", "clevis_pin",
+           "split_pin", "hexagon_nut", "plain_washer", "pin", "set_screw", "retaining_ring",
+           "spring", "roller"]
 
 
 def _sides(size: dict, segments: int) -> int:
@@ -91,16 +101,42 @@ def parallel_key(size: dict, segments: int):
         (0.0, -width / 2, 0.0))
 
 
-def socket_head_cap_screw(size: dict, segments: int):
-    """A socket head cap screw: head above the origin, shank below."""
+def _headed(size: dict, segments: int, path: str):
+    """A round head ``z`` 0 to k above the origin on a shank ``z`` -l to 0 (a screw, a clevis
+    pin: both measure their length from under the head)."""
     from cadgen.solids.extrude import extrude, manifold3d_engine
 
     d, length, head, k = _positive(size, "d", "length", "head_diameter", "head_height")
     sides = _sides(size, segments)
     m3d = manifold3d_engine()
-    parts = [extrude(circle(head / 2, sides), k, path="screw head"),
-             extrude(circle(d / 2, sides), length, z0=-length, path="screw shank")]
+    parts = [extrude(circle(head / 2, sides), k, path=f"{path} head"),
+             extrude(circle(d / 2, sides), length, z0=-length, path=f"{path} shank")]
     return m3d.Manifold.batch_boolean(parts, m3d.OpType.Add)
+
+
+def socket_head_cap_screw(size: dict, segments: int):
+    """A socket head cap screw: head above the origin, shank below."""
+    return _headed(size, segments, "screw")
+
+
+def clevis_pin(size: dict, segments: int):
+    """An ISO 2341 B clevis pin: head above the origin, shank below (its split-pin hole and
+    chamfers left out: the split pin's solid crosses the shank where the hole is)."""
+    return _headed(size, segments, "clevis pin")
+
+
+def split_pin(size: dict, segments: int):
+    """An ISO 1234 split pin as its envelope, straight as it goes in (legs not yet bent): the
+    two half-round legs together a cylinder ``d`` across, ``z`` -l to 0 below the eye's
+    bearing face; the eye a block ``c`` wide along ``x``, ``c`` high, ``d`` thick along ``y``
+    (the loop of a wire ``d`` wide lies in the legs' plane, ``x``-``z``)."""
+    from cadgen.solids.extrude import extrude, manifold3d_engine
+
+    d, eye, length = _positive(size, "d", "c", "length")
+    m3d = manifold3d_engine()
+    block = m3d.Manifold.cube((eye, d, eye)).translate((-eye / 2, -d / 2, 0.0))
+    legs = extrude(circle(d / 2, _sides(size, segments)), length, z0=-length, path="split pin")
+    return m3d.Manifold.batch_boolean([block, legs], m3d.OpType.Add)
 
 
 def hexagon_nut(size: dict, segments: int):
@@ -169,5 +205,7 @@ for _kind, _maker in (("bearing", bearing), ("key", parallel_key),
                       ("hexagon nut", hexagon_nut), ("plain washer", plain_washer),
                       ("dowel pin", pin), ("pin", pin), ("set screw", set_screw),
                       ("retaining ring", retaining_ring), ("spring", spring),
-                      ("roller", roller)):
+                      ("roller", roller), ("clevis pin", clevis_pin), ("split pin", split_pin),
+                      ("washer", plain_washer), ("parallel pin", pin),
+                      ("compression spring", spring)):
     register_maker(_kind, _maker)

@@ -238,6 +238,10 @@ def shell_features(shell, fixing, layout, segments: int):
         cuts.append(_cylinder_z(centre, hinge["knuckle_radius"] + hinge["clearance"],
                                 axis - hinge["ear_from"], axis + hinge["ear_from"], segments))
         cuts.append(_pin_end_zone(fixing, centre, axis, beyond, segments))
+        # the pin's hole through the ears and the tube's wall they stand in (the wall fills the
+        # ears' holes where they overlap it: the hinge pin found it)
+        cuts.append(_cylinder_z(centre, hinge["hole"] / 2, axis - beyond - 1.0,
+                                axis + beyond + 1.0, segments))
         for sign in (1.0, -1.0):
             near, far = sorted((axis + sign * hinge["ear_from"], axis + sign * beyond))
             adds.append(_prism(ear_outline, near, far, [_hole(centre, hinge["hole"], segments)],

@@ -1,8 +1,7 @@
 """The planting mechanism's solids: gears, gearbox 1, gearbox 2, cam, planter shell, blades, ground.
 
-Frames. The mechanism plane is z = 0 of the world (x forward, y up), z towards
-the arms. Bodies and their poses at carrier angle ``phi`` (arm 2 is arm 1 at
-``phi + pi``):
+Frames. The mechanism plane is z = 0 of the world (x forward, y up), z towards the arms. Bodies and
+their poses at carrier angle ``phi`` (arm 2 is arm 1 at ``phi + pi``):
 
 ``frame``
     Fixed: the frame (the transmission box) and its input shaft and gears.
@@ -20,27 +19,26 @@ the arms. Bodies and their poses at carrier angle ``phi`` (arm 2 is arm 1 at
 ``ground``
     Fixed: the soil (flat or a ridge along the travel), its top at the soil level.
 
-Axial stack (z, from the machine outwards): gearbox 1 (train 1's gears), gearbox
-2 (layer 1: the non-circular pair; layer 2: the 1:1 circular pair), the cam plate
-(the duckbill's roller in it), the duckbill lever's layer, the planter's arm plate,
-and the duckbill tube beside it. Every gap between them is ``housing.axial_gap``; the housings' end walls, cavity heights, gear layers and
-parting planes are the drivetrain's (:class:`~cadgen.machine.model.HousingStack`,
-end walls thick enough for the bearing seats). The housings' outlines are the
-hull of the same envelope discs the kinematic clearance checks use (largest tip +
-clearance + wall), so both checks see one housing.
+Axial stack (z, from the machine outwards): gearbox 1 (train 1's gears), gearbox 2 (layer 1: the
+non-circular pair; layer 2: the 1:1 circular pair), the cam plate (the duckbill's roller in it),
+the duckbill lever's layer, the planter's arm plate, and the duckbill tube beside it. Every gap
+between them is ``housing.axial_gap``; the housings' end walls, cavity heights, gear layers and
+parting planes are the drivetrain's (:class:`~cadgen.machine.model.HousingStack`, end walls thick
+enough for the bearing seats). The housings' outlines are the hull of the same envelope discs the
+kinematic clearance checks use (largest tip + clearance + wall), so both checks see one housing.
 
 Each housing is split at its parting plane into a base and a cover
-(:mod:`cadgen.solids.split_housing`) with the bearing seats bored in its end walls;
-each shaft is a part of its housing's body (:mod:`cadgen.solids.machine_parts`).
+(:mod:`cadgen.solids.split_housing`) with the bearing seats bored in its end walls; each shaft is a
+part of its housing's body (:mod:`cadgen.solids.machine_parts`).
 
-Each part is built once, in its body's frame; which copies exist (per arm, per
-side of carrier 1) and where they ride is the assembly model's to say
-(:mod:`cadgen.assembly.machine`, :func:`~cadgen.solids.parts.placed_assembly`).
-The duckbill linkage (lever, push rod, links, the blades' knuckles and cranks, the
-shell's lug, web and hinge ears) is :mod:`cadgen.solids.duckbill`'s, cut to the sizes
-the drivetrain gave it (``fixings["duckbill"]``). The bought items (bearings, keys, screws,
-nuts, washers, dowels: on the model's joints, in the bill) are placed as solids by the parts
-that hold them (:mod:`cadgen.solids.bought`).
+Each part is built once, in its body's frame; which copies exist (per arm, per side of carrier 1)
+and where they ride is the assembly model's to say (:mod:`cadgen.assembly.machine`,
+:func:`~cadgen.solids.parts.placed_assembly`). The duckbill linkage (lever, push rod, links, the
+blades' knuckles and cranks, the shell's lug, web and hinge ears) is
+:mod:`cadgen.solids.duckbill`'s, cut to the sizes the drivetrain gave it (``fixings["duckbill"]``).
+The bought items (bearings, keys, screws, nuts, washers, dowels, the linkage's pins, roller and
+spring: on the model's joints, in the bill) are placed as solids by the parts that hold them
+(:mod:`cadgen.solids.bought`; the linkage's: :mod:`cadgen.solids.duckbill_items`).
 """
 
 from __future__ import annotations
@@ -440,12 +438,10 @@ def _planter_parts(params, cam_design, layout, segments, hub=None, duckbill=None
     the plate's boss at E, up from the plate, and its bore with the keyway (towards the
     planter's +x, where shaft E's keyseat is cut to meet it).
     """
-    from cadgen.solids.extrude import manifold3d_engine
+    from cadgen.solids.extrude import extrude, manifold3d_engine
+    from cadgen.solids.outline import hull_of_circles
 
     m3d = manifold3d_engine()
-
-    from cadgen.solids.extrude import extrude
-    from cadgen.solids.outline import hull_of_circles
 
     planter = params.planter
     L1, L2, wall = planter.L1, planter.L2, planter.shell_wall
@@ -467,21 +463,21 @@ def _planter_parts(params, cam_design, layout, segments, hub=None, duckbill=None
     tube_length = -hinge_y
     tube = (m3d.Manifold.cylinder(tube_length, outer, outer, segments)
             - m3d.Manifold.cylinder(tube_length, outer - wall, outer - wall, segments))
-    tube = _stand_up(tube).translate((-L1, hinge_y, layout.tube_axis))
+    # built along +z, stood up along +y (a turn of -90 deg about x)
+    tube = tube.rotate((-90.0, 0.0, 0.0)).translate((-L1, hinge_y, layout.tube_axis))
     shell = plate + tube
     # the duckbill: a cone shell from the hinge circle (radius e) down to the tip N, split in halves
     height = lb * math.cos(d0)
     cone = m3d.Manifold.cylinder(height, 0.0, e + wall, segments)
     inner = m3d.Manifold.cylinder(height, 0.0, e, segments).translate((0.0, 0.0, wall / math.sin(d0)))
-    cone = _stand_up(cone - inner).translate((-L1, -L2, layout.tube_axis))
-    right = cone ^ m3d.Manifold.cube((outer * 4, L2 * 2, outer * 4)).translate(
+    cone = (cone - inner).rotate((-90.0, 0.0, 0.0)).translate((-L1, -L2, layout.tube_axis))
+    beyond_axis = m3d.Manifold.cube((outer * 4, L2 * 2, outer * 4)).translate(
         (-L1, -2 * L2, layout.tube_axis - 2 * outer))
-    left = cone - m3d.Manifold.cube((outer * 4, L2 * 2, outer * 4)).translate(
-        (-L1, -2 * L2, layout.tube_axis - 2 * outer))
+    right, left = cone ^ beyond_axis, cone - beyond_axis
     opening = cam_design.profile if cam_design is not None else None
 
-    def blade_local(sign, pivot):
-        def local(phi):
+    def blade_local(sign):
+        def local(phi, pivot=np.array([-L1 + sign * e, hinge_y])):   # about its hinge
             if opening is None:
                 return np.eye(4)
             lam = opening.program(np.array([float(cam_design.cam_angle(phi))]))[0]
@@ -491,24 +487,22 @@ def _planter_parts(params, cam_design, layout, segments, hub=None, duckbill=None
             return (planar_transform(0.0, pivot) @ turn @ planar_transform(0.0, -pivot))
         return local
 
-    hinge_right = np.array([-L1 + e, hinge_y])
-    hinge_left = np.array([-L1 - e, hinge_y])
-    linkage = []
+    linkage, items = [], {}
     if duckbill is not None and cam_design is not None and layout.lever_bottom is not None:
         from cadgen.solids.duckbill import blade_features, linkage_parts, shell_features
+        from cadgen.solids.duckbill_items import linkage_items
 
         shell = shell_features(shell, duckbill, layout, segments)
         right = blade_features(right, "right", duckbill, layout, segments)
         left = blade_features(left, "left", duckbill, layout, segments)
         linkage = linkage_parts(duckbill, layout, cam_design, segments)
-    return [Part("planter-shell", "planter", "planter", shell),
-            Part("blade-right", "blade", "planter", right, blade_local(1.0, hinge_right)),
-            Part("blade-left", "blade", "planter", left, blade_local(-1.0, hinge_left))] + linkage
-
-
-def _stand_up(solid):
-    """Turn a solid built along +z so that its axis runs along +y (rotation about x by -90 deg)."""
-    return solid.rotate((-90.0, 0.0, 0.0))
+        items = linkage_items(duckbill, layout)   # its pins, roller and spring, by host
+    parts = [Part("planter-shell", "planter", "planter", shell),
+             Part("blade-right", "blade", "planter", right, blade_local(1.0)),
+             Part("blade-left", "blade", "planter", left, blade_local(-1.0))] + linkage
+    for part in parts:
+        part.bought += tuple(items.get(part.name, ()))
+    return parts
 
 
 def mechanism_extent(mechanism, circles, steps: int = 360) -> tuple:
