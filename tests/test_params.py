@@ -323,8 +323,12 @@ def test_optional_tables_take_the_defaults():
     params = validate_text(text, check_feasibility=False)
     reference = load_params(REFERENCE, check_feasibility=False)
     # the reference spells out every default but its gears' face width (wide enough for keys)
+    # and their steel (C45+N's flanks fall below S_H 1 at the design load)
     assert reference.gears.face_width == 25.0
-    assert params.model_copy(update={"gears": reference.gears}) == reference
+    assert (params.machine.gear_material, reference.machine.gear_material) == (
+        None, "steel 42CrMo4+QT")
+    steel = params.machine.model_copy(update={"gear_material": "steel 42CrMo4+QT"})
+    assert params.model_copy(update={"gears": reference.gears, "machine": steel}) == reference
     assert params.gears == reference.gears.model_copy(update={"face_width": None})
 
 

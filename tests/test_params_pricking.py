@@ -217,9 +217,9 @@ def test_example_comments_name_every_quantity(path):
         assert "#" in stripped, line  # key = value lines and the point lines
         checked += 1
     # top level 2; [trajectory] 15 (points = [, 12 points, degree, sun_centre); [linkage] 1;
-    # [gears] 7; [field] 4; [resolution] 1; [machine] 8 (the tooth safety limits too);
-    # [manufacturing] 2
-    assert checked == 2 + 15 + 1 + 7 + 4 + 1 + 8 + 2
+    # [gears] 7; [field] 4; [resolution] 1; [machine] 9 (the tooth safety limits and the gears'
+    # material too); [manufacturing] 2
+    assert checked == 2 + 15 + 1 + 7 + 4 + 1 + 9 + 2
     assert "mirror" in text.lower()  # the header says the spec's points are mirrored in x
     assert "assumed" in text  # the forward speed is an assumption, not the paper's
 
@@ -439,10 +439,14 @@ def test_unknown_mechanism_lists_both_kinds():
 def test_optional_keys_and_tables_take_the_defaults():
     params = validate_text(_with(MINIMAL, "forward_speed", "530.0"))
     example = load_params(KERNEL_A)
-    # the example spells out every default, and widens the gears for their keys
+    # the example spells out every default, widens the gears for their keys and names their
+    # steel (C45+N's flanks fall below S_H 1 at the design load)
     assert example.gears.face_width == 20.0
+    assert (params.machine.gear_material, example.machine.gear_material) == (
+        None, "steel 42CrMo4+QT")
     widened = params.gears.model_copy(update={"face_width": 20.0})
-    assert params.model_copy(update={"gears": widened}) == example
+    steel = params.machine.model_copy(update={"gear_material": "steel 42CrMo4+QT"})
+    assert params.model_copy(update={"gears": widened, "machine": steel}) == example
 
 
 @pytest.mark.parametrize("value", ["0", "0.0", "2", "2.5", "4", "4.0"])
