@@ -14,7 +14,7 @@ angle) with its analytic first and second derivatives, and ``phi`` turns at a co
 Ideal joints do no work (a mesh's force acts at the pitch point, where the two gears roll
 without sliding), so the two routes give the same input torque when the model is right:
 their difference is the check. Friction enters both as known couples (from the reactions
-of a previous solve, see :func:`solve_with_friction`), so both see the same losses.
+of the previous round, see :func:`newton_euler`), so both see the same losses.
 
 Units: m, kg, s, N, N m; ``phi`` in rad. Shapes: ``n`` poses, ``B`` bodies.
 """
@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["BodyMotion", "Revolute", "Mesh", "PointLoad", "Couple", "Model", "Solution",
-           "newton_euler", "power_balance", "solve_with_friction", "kinetic_energy",
-           "potential_energy", "FRAME", "GRAVITY"]
+           "newton_euler", "system_inverse", "power_balance", "friction_couples",
+           "kinetic_energy", "potential_energy", "load_power", "FRAME", "GRAVITY"]
 
 #: The fixed frame's name: a joint to it has no body on its other side.
 FRAME = "frame"
@@ -96,8 +96,8 @@ class Mesh:
     ``tangent`` and ``normal`` (n, 2) are unit vectors of the pitch curves' common tangent
     and normal at the pitch point, ``normal`` pointing from the driver's side into the
     driven gear's (the tooth force always pushes the gears apart). The line of action is
-    ``d = s cos(alpha) tangent + sin(alpha) normal``, the flank sign ``s`` chosen so that
-    ``F_n >= 0``. ``friction_arm`` (m) is the mean sliding distance from the pitch point.
+    ``d = s cos(alpha) tangent + sin(alpha) normal``, the flank sign ``s`` the sign of the
+    tangential force (:func:`newton_euler`). ``friction_arm`` (m) is the mean sliding distance from the pitch point.
     """
 
     name: str
@@ -174,34 +174,121 @@ class Solution:
     shaking_force: np.ndarray
     shaking_moment: np.ndarray
     friction_couples: tuple = field(default=())
+    tangential: dict = field(default_factory=dict)   # {mesh: (n,) signed F_t along tangent}
 
 
-def _directions(mesh: Mesh, sign):
-    alpha = mesh.pressure_angle
-    return sign[:, None] * np.cos(alpha) * mesh.tangent + np.sin(alpha) * mesh.normal
+def system_inverse(model: Model) -> np.ndarray:
+    """The inverse (n, 3B, 3B) of the Newton-Euler system: it depends on the geometry only
+    (a mesh's unknown is its tangential force, along the common tangent), so every load case,
+    friction round and speed of one model's motion shares it (a product, not a solve)."""
+    return np.linalg.inv(_matrix(model))
 
 
-def newton_euler(model: Model, signs: dict | None = None, *, max_flips: int = 6) -> Solution:
+def newton_euler(model: Model, *, inverse=None, bearing_friction: float = 0.0,
+                 mesh_friction: float = 0.0, rtol: float = 1e-13, max_rounds: int = 200):
     """Solve every body's Newton-Euler equations with its joints at every pose.
 
-    The flank in contact is part of the answer: each mesh starts on the flank ``signs``
-    gives (``+1`` by default) and changes flank where its force came out negative, until
-    every normal force is ``>= 0`` (at most ``max_flips`` solves).
+    A mesh's unknown is its tangential force ``F_t`` (signed, along the common tangent); the
+    tooth force's other component, ``tan(alpha) |F_t|`` along the common normal (it always
+    pushes the gears apart, whichever flank carries), and Coulomb friction (bearings:
+    ``mu_b |R| r``; meshes: ``mu_m F_n s``, :func:`friction_couples`) depend on the answer:
+    they are known loads taken from the previous round, until the input torque changes by
+    less than ``rtol`` of its peak. Returns ``(solution, model with the final friction
+    couples, rounds, last relative change)``: :func:`power_balance` of that model sees the
+    same losses.
     """
+    inverse = system_inverse(model) if inverse is None else inverse
+    base = model.couples
+    tangential = {m.name: np.zeros(len(model.phi)) for m in model.meshes}
+    current, solution, change = model, None, np.inf
+    fixed = _known_rhs(model)      # inertia, gravity and the given loads: the same each round
+    for rounds in range(1, max_rounds + 1):
+        previous = solution
+        solution = _solve(current, inverse, tangential, fixed)
+        tangential = solution.tangential
+        if previous is not None:
+            scale = max(float(np.max(np.abs(solution.input_torque))), 1e-300)
+            change = float(np.max(np.abs(solution.input_torque - previous.input_torque))) / scale
+            change = max(change, max(
+                float(np.max(np.abs(solution.mesh_forces[k] - previous.mesh_forces[k])))
+                / max(float(np.max(solution.mesh_forces[k])), 1e-300) for k in tangential)
+                if tangential else 0.0)
+            if change <= rtol:
+                break
+        if bearing_friction or mesh_friction:
+            couples = friction_couples(model, solution, bearing_friction, mesh_friction)
+            current = Model(model.phi, model.omega, model.bodies, model.revolutes, model.meshes,
+                            model.input_body, model.loads, base + couples, model.gravity)
+    solution.friction_couples = current.couples[len(base):]
+    return solution, current, rounds, change
+
+
+def _known_rhs(model: Model) -> np.ndarray:
+    """The right-hand side of the bodies' inertia, gravity and given loads (not the couples)."""
+    index = model.index()
+    n, size = len(model.phi), 3 * len(model.bodies)
+    rhs = np.zeros((n, size))
+    omega2 = model.omega ** 2
+    for k, body in enumerate(model.bodies):
+        rhs[:, 3 * k:3 * k + 2] = body.mass * body.centre_accel * omega2
+        rhs[:, 3 * k + 1] += body.mass * model.gravity
+        rhs[:, 3 * k + 2] = body.inertia * body.angle_accel * omega2
+
+    for load in model.loads:           # known: to the right-hand side
+        for name, sign in ((load.body, 1.0), (load.other, -1.0)):
+            if name is None or name == FRAME:
+                continue
+            k = index[name]
+            rhs[:, 3 * k:3 * k + 2] -= sign * load.force
+            rhs[:, 3 * k + 2] -= sign * _cross(load.point - model.bodies[k].centre, load.force)
+    return rhs
+
+
+def _solve(model: Model, inverse, tangential: dict, fixed) -> Solution:
+    """One linear solve with the meshes' separating forces from ``tangential`` and the
+    model's couples known (``fixed``: :func:`_known_rhs`)."""
+    index = model.index()
     n = len(model.phi)
-    signs = {m.name: np.ones(n) if signs is None or m.name not in signs else signs[m.name]
-             for m in model.meshes}
-    for _ in range(max_flips):
-        solution = _solve(model, {m.name: _directions(m, signs[m.name]) for m in model.meshes})
-        negative = {name: force < 0 for name, force in solution.mesh_forces.items()}
-        if not any(mask.any() for mask in negative.values()):
-            return solution
-        for name, mask in negative.items():
-            signs[name] = np.where(mask, -signs[name], signs[name])
-    return solution
+    rhs = fixed.copy()
+    for couple in model.couples:
+        rhs[:, 3 * index[couple.body] + 2] -= couple.moment
+        if couple.other != FRAME:
+            rhs[:, 3 * index[couple.other] + 2] += couple.moment
+    for mesh in model.meshes:          # the separating component, from the last round
+        push = np.tan(mesh.pressure_angle) * np.abs(tangential[mesh.name])[:, None] * mesh.normal
+        for name, sign in ((mesh.driven, 1.0), (mesh.driver, -1.0)):
+            if name != FRAME:
+                k = index[name]
+                rhs[:, 3 * k:3 * k + 2] -= sign * push
+                rhs[:, 3 * k + 2] -= sign * _cross(mesh.point - model.bodies[k].centre, push)
+    unknowns = np.einsum("nij,nj->ni", inverse, rhs)
+    reactions, forces, directions, along = {}, {}, {}, {}
+    shaking_force = np.zeros((n, 2))
+    shaking_moment = -unknowns[:, -1]        # the motor's stator reacts on the frame
+    column = 0
+    for joint in model.revolutes:
+        reactions[joint.name] = unknowns[:, column:column + 2]
+        if joint.base == FRAME:
+            shaking_force -= reactions[joint.name]
+            shaking_moment -= _cross(joint.point, reactions[joint.name])
+        column += 2
+    for mesh in model.meshes:
+        along[mesh.name] = unknowns[:, column]
+        alpha = mesh.pressure_angle
+        forces[mesh.name] = np.abs(along[mesh.name]) / np.cos(alpha)
+        flank = np.where(along[mesh.name] < 0, -1.0, 1.0)[:, None]
+        directions[mesh.name] = flank * np.cos(alpha) * mesh.tangent + np.sin(alpha) * mesh.normal
+        column += 1
+    for couple in model.couples:
+        if couple.other == FRAME:
+            shaking_moment -= couple.moment
+    return Solution(unknowns[:, -1], reactions, forces, directions, shaking_force,
+                    shaking_moment, model.couples, along)
 
 
-def _solve(model: Model, directions: dict) -> Solution:
+def _matrix(model: Model) -> np.ndarray:
+    """The (n, 3B, 3B) coefficients: each body's force and moment rows, each joint's columns
+    (a revolute's two force components, a mesh's tangential force, the input torque last)."""
     index = model.index()
     n, count = len(model.phi), len(model.bodies)
     size = 3 * count
@@ -210,12 +297,6 @@ def _solve(model: Model, directions: dict) -> Solution:
         raise ValueError(f"{count} bodies need {size} unknowns, the joints give {columns}: "
                          "the mechanism must have exactly one freedom")
     matrix = np.zeros((n, size, size))
-    rhs = np.zeros((n, size))
-    omega2 = model.omega ** 2
-    for k, body in enumerate(model.bodies):
-        rhs[:, 3 * k:3 * k + 2] = body.mass * body.centre_accel * omega2
-        rhs[:, 3 * k + 1] += body.mass * model.gravity
-        rhs[:, 3 * k + 2] = body.inertia * body.angle_accel * omega2
 
     def put_force(name, column, vector, point, sign=1.0):
         if name == FRAME:
@@ -238,40 +319,11 @@ def _solve(model: Model, directions: dict) -> Solution:
         put_force(joint.base, column, None, joint.point, -1.0)
         column += 2
     for mesh in model.meshes:
-        put_force(mesh.driven, column, directions[mesh.name], mesh.point)
-        put_force(mesh.driver, column, directions[mesh.name], mesh.point, -1.0)
+        put_force(mesh.driven, column, mesh.tangent, mesh.point)
+        put_force(mesh.driver, column, mesh.tangent, mesh.point, -1.0)
         column += 1
     matrix[:, 3 * index[model.input_body] + 2, column] = 1.0
-    for load in model.loads:           # known: to the right-hand side
-        for name, sign in ((load.body, 1.0), (load.other, -1.0)):
-            if name is None or name == FRAME:
-                continue
-            k = index[name]
-            rhs[:, 3 * k:3 * k + 2] -= sign * load.force
-            rhs[:, 3 * k + 2] -= sign * _cross(load.point - model.bodies[k].centre, load.force)
-    for couple in model.couples:
-        rhs[:, 3 * index[couple.body] + 2] -= couple.moment
-        if couple.other != FRAME:
-            rhs[:, 3 * index[couple.other] + 2] += couple.moment
-    unknowns = np.linalg.solve(matrix, rhs[..., None])[..., 0]
-    reactions, forces = {}, {}
-    shaking_force = np.zeros((n, 2))
-    shaking_moment = -unknowns[:, -1]        # the motor's stator reacts on the frame
-    column = 0
-    for joint in model.revolutes:
-        reactions[joint.name] = unknowns[:, column:column + 2]
-        if joint.base == FRAME:
-            shaking_force -= reactions[joint.name]
-            shaking_moment -= _cross(joint.point, reactions[joint.name])
-        column += 2
-    for mesh in model.meshes:
-        forces[mesh.name] = unknowns[:, column]
-        column += 1
-    for couple in model.couples:
-        if couple.other == FRAME:
-            shaking_moment -= couple.moment
-    return Solution(unknowns[:, -1], reactions, forces, directions, shaking_force,
-                    shaking_moment, model.couples)
+    return matrix
 
 
 def kinetic_energy(model: Model) -> np.ndarray:
@@ -350,36 +402,3 @@ def friction_couples(model: Model, solution: Solution, bearing_friction: float,
         couples.append(Couple(f"mesh {mesh.name}", mesh.driven, -magnitude * relative,
                               mesh.driver))
     return tuple(couples)
-
-
-def solve_with_friction(model: Model, bearing_friction: float, mesh_friction: float, *,
-                        rtol: float = 1e-12, max_rounds: int = 30):
-    """Newton-Euler with Coulomb friction in every joint: ``(model with its friction
-    couples, solution, rounds, last relative change)``.
-
-    Friction depends on the reactions it changes: solved by fixed-point rounds, each a
-    frictionless-joint solve with the previous round's friction couples as known loads
-    (the change shrinks by about the friction coefficient each round). The returned model
-    holds the final couples, so :func:`power_balance` of it sees the same losses.
-    """
-    base = model.couples
-    solution = newton_euler(model)
-    if bearing_friction == 0.0 and mesh_friction == 0.0:
-        return model, solution, 0, 0.0
-    change = np.inf
-    current = model
-    signs = None
-    for rounds in range(1, max_rounds + 1):
-        couples = friction_couples(model, solution, bearing_friction, mesh_friction)
-        current = Model(model.phi, model.omega, model.bodies, model.revolutes, model.meshes,
-                        model.input_body, model.loads, base + couples, model.gravity)
-        signs = {m.name: np.sign(np.sum(solution.mesh_directions[m.name] * m.tangent, axis=1))
-                 for m in model.meshes}
-        signs = {k: np.where(v == 0, 1.0, v) for k, v in signs.items()}
-        updated = newton_euler(current, signs)
-        scale = max(float(np.max(np.abs(solution.input_torque))), 1e-300)
-        change = float(np.max(np.abs(updated.input_torque - solution.input_torque))) / scale
-        solution = updated
-        if change <= rtol:
-            break
-    return current, solution, rounds, change
