@@ -13,9 +13,8 @@ from kinematics.rigid_dynamics import (FRAME, BodyMotion, Model, Revolute, newto
                                        power_balance)
 
 from cadgen.dynamics import planting_dynamics
-from cadgen.params import load_params
 
-from tests.helpers import REFERENCE as PAPER
+from tests.helpers import stages_before_dynamics
 
 
 
@@ -54,14 +53,7 @@ def test_an_unbalanced_disc_needs_its_weight_moment_and_its_bearing_the_centripe
 @pytest.fixture(scope="module")
 def paper_stages():
     """The paper's design through the stages the dynamics reads (no solids: estimated)."""
-    from cadgen.pipeline import build as pipeline
-    from cadgen.pipeline.plan import check_build
-
-    checked = check_build(load_params(PAPER), effects=["dynamics"])
-    run = pipeline._Build(checked.params, [s for s in checked.stages if s != "dynamics"], None)
-    run.effects, run.parallel = checked.effects, False
-    run.run(pipeline.STAGE_FUNCTIONS)
-    return run
+    return stages_before_dynamics()
 
 
 def _dynamics(run, **changes):

@@ -23,6 +23,8 @@ value, ``run.values["dynamics"]``) is a :class:`DynamicsResult`:
   - ``contact_angle[gear]`` (n,) rad: the polar angle of the pitch point in that gear's own
     frame (the gear as it sits at the catching pose, ``phi = 0``), for each of the two gears;
   - ``contact_radius[gear]`` (n,) mm: the pitch point's distance from that gear's axis;
+  - ``line_of_action`` (n, 2): the unit direction of the force on the driven gear (world
+    frame; its sign says which flank carries);
   - ``pitch_parameter`` (n,) rad for the non-circular pair: ``t`` of the central gear's pitch
     curve ``r1(t)`` at the contact (the intermediate's radius there is ``a - r1(t)``), None
     for a circular pair.

@@ -37,6 +37,7 @@ class MeshLoad:
     normal_force_n: np.ndarray  # (n,) along the line of action, >= 0
     contact_angle: dict         # {gear: (n,) polar angle of the contact in its own frame, rad}
     contact_radius: dict        # {gear: (n,) distance of the contact from its axis, mm}
+    line_of_action: np.ndarray | None = None    # (n, 2) unit: the force's sense on the driven gear
     pitch_parameter: np.ndarray | None = None   # (n,) t of r1(t): the non-circular pair
 
 
@@ -231,7 +232,7 @@ def _mesh_loads(mechanism, drive, model, solution, contacts) -> dict:
         parameter = (np.mod(phi + math.pi * (side - 1), 2 * math.pi)
                      if (driver_gear, driven_gear) == ("central", "intermediate") else None)
         out[key] = MeshLoad((driver_gear, driven_gear), side, solution.mesh_forces[key], angles,
-                            radii, parameter)
+                            radii, solution.mesh_directions[key], parameter)
     assert set(MESH_GEARS) <= {k[:2] for k in out}
     return out
 
