@@ -19,7 +19,7 @@ from . import tolerances as tol
 from .pitch_curves import Closure, LimaconPitchCurve, polar_perimeter, solve_closure
 from .planar import unit as _unit, perp as _perp
 
-__all__ = ["PlantingMechanism", "PointMotion", "ARM_POINTS", "CENTRE_LINE"]
+__all__ = ["PlantingMechanism", "PointMotion", "ARM_POINTS", "CENTRE_LINE", "rotating_offset"]
 
 #: Named points of one arm, from the carrier to the duckbill tip.
 ARM_POINTS = ("A", "B", "C", "D", "E", "P1", "N")
@@ -151,12 +151,12 @@ class PlantingMechanism:
         centre = self._carrier_point(phi, self.carrier_radii["C"])
         if point in ("D", "E"):
             reach = self.centre_distance + (2 * self.r if point == "E" else 0.0)
-            return _rotating_offset(centre, self.phic + phi, 1.0, 0.0, reach * np.array([1.0, 0.0]))
-        hub = _rotating_offset(centre, self.phic + phi, 1.0, 0.0,
+            return rotating_offset(centre, self.phic + phi, 1.0, 0.0, reach * np.array([1.0, 0.0]))
+        hub = rotating_offset(centre, self.phic + phi, 1.0, 0.0,
                                (self.centre_distance + 2 * self.r) * np.array([1.0, 0.0]))
         psi, dpsi, ddpsi = self.attitude_derivatives(phi)
         offset = np.array([-self.L1, 0.0 if point == "P1" else -self.L2])
-        return _rotating_offset(hub, psi, dpsi, ddpsi, offset)
+        return rotating_offset(hub, psi, dpsi, ddpsi, offset)
 
     def absolute_motion(self, phi, spacing: float, point: str = "N", arm: int = 0) -> PointMotion:
         """Motion over the ground at plant spacing ``spacing`` (mm).
@@ -268,7 +268,7 @@ class PlantingMechanism:
         return 2.0 * (self.carrier_radii["C"] + self.centre_distance + 2 * self.r)
 
 
-def _rotating_offset(base: PointMotion, angle, rate, rate_rate, offset) -> PointMotion:
+def rotating_offset(base: PointMotion, angle, rate, rate_rate, offset) -> PointMotion:
     """Motion of ``base + Rot(angle) @ offset`` where ``angle`` has the given derivatives.
 
     ``Q' = B' + angle' J Rot q``, ``Q'' = B'' + angle'' J Rot q - angle'^2 Rot q``.

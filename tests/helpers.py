@@ -124,3 +124,17 @@ def tagged_processes(tag: str) -> list[str]:
         if stat[stat.rindex(")") + 2] != "Z":
             alive.append(stat[:stat.rindex(")") + 1])
     return alive
+
+
+def stages_before_dynamics(path=REFERENCE):
+    """A build of ``path`` run through the stages the dynamics reads (kinematics, metrics, cam,
+    drivetrain), not the dynamics themselves: ``run.values`` holds their results."""
+    from cadgen.params import load_params
+    from cadgen.pipeline import build as pipeline
+    from cadgen.pipeline.plan import check_build
+
+    checked = check_build(load_params(path), effects=["dynamics"])
+    run = pipeline._Build(checked.params, [s for s in checked.stages if s != "dynamics"], None)
+    run.effects, run.parallel = checked.effects, False
+    run.run(pipeline.STAGE_FUNCTIONS)
+    return run

@@ -36,16 +36,21 @@ ALLOWED = {
     "cadgen.solids": {"kinematics", "cadgen.params", "cadgen.geometry", "cadgen.gears",
                       "cadgen.machine", "cadgen.assembly"},
     "cadgen.design": {"kinematics", "cadgen.solids"},
+    # the dynamics: the kinematics' motion, the drive, journals and spring of the machine's
+    # records, the cam's contact (follower), the solids' mass properties
+    "cadgen.dynamics": {"kinematics", "cadgen.params", "cadgen.gears", "cadgen.cam",
+                        "cadgen.machine", "cadgen.solids"},
     "cadgen.sweep": {"kinematics", "cadgen.solids"},
     "cadgen.params.feasibility": {"kinematics", "cadgen.params", "cadgen.design", "cadgen.cam"},
     # (cadgen.processes: a staged folder is made and swapped in with Ctrl-C held back)
     "cadgen.export": {"kinematics", "cadgen.geometry", "cadgen.gears", "cadgen.solids",
                       "cadgen.machine", "cadgen.processes"},
     "cadgen.report": {"kinematics", "cadgen", "cadgen.cam", "cadgen.export", "cadgen.gears",
-                      "cadgen.solids", "cadgen.machine", "cadgen.assembly"},
+                      "cadgen.solids", "cadgen.machine", "cadgen.assembly", "cadgen.dynamics"},
     "cadgen.pipeline": {"kinematics", "cadgen.params", "cadgen.params.feasibility",
                         "cadgen.geometry", "cadgen.gears", "cadgen.cam", "cadgen.machine",
                         "cadgen.solids", "cadgen.design", "cadgen.sweep", "cadgen.export", "cadgen.report",
+                        "cadgen.dynamics",
                         # the worker beside the teeth: started whole, dying with the build
                         "cadgen.processes"},
     "cadgen.batch": {"kinematics", "cadgen.params", "cadgen.export", "cadgen.pipeline",

@@ -44,8 +44,8 @@ from cadgen.machine.follower import Body, follower_forces
 from cadgen.machine.pins import clevis_pin_length, retaining_ring, roller_bearing, PIN_LENGTHS
 from cadgen.machine.springs import design_compression_spring
 
-__all__ = ["duckbill_fixing", "duckbill_report", "duckbill_geometry", "stadium", "lever_arms",
-           "plate_properties", "PIN_DIAMETERS", "LINK_THICKNESS", "ROD_DIAMETER"]
+__all__ = ["duckbill_fixing", "duckbill_report", "duckbill_geometry", "linkage_bodies", "stadium",
+           "lever_arms", "plate_properties", "PIN_DIAMETERS", "LINK_THICKNESS", "ROD_DIAMETER"]
 
 #: Pin diameters at each joint (mm). The loads are tens of newtons (the report gives them):
 #: the sizes are the smallest that keep a plate's eye and the pins easy to handle; G's pin is
@@ -267,7 +267,7 @@ def duckbill_geometry(params, linkage, fits=None) -> dict:
     }
 
 
-def _bodies(params, linkage, geometry, fits) -> list:
+def linkage_bodies(params, linkage, geometry, fits) -> list:
     """The linkage's moving bodies with their masses (estimated from the parts' outlines)."""
     density = {kind: (fits.material(kind).density if fits is not None else STEEL_DENSITY)
                for kind in ("lever", "push-rod", "link", "blade")}
@@ -392,7 +392,7 @@ def duckbill_fixing(params, mechanism, cam, fits=None) -> tuple:
                                 "stroke: a longer blade link or roller arm makes some"))
     if problems:
         return None, problems
-    bodies = _bodies(params, linkage, geometry, fits)
+    bodies = linkage_bodies(params, linkage, geometry, fits)
     speed = params.field.carrier_speed_rpm
     forces = follower_forces(linkage, cam.profile, cam.cam_angle, mechanism, bodies, speed)
     spring, why = design_compression_spring(

@@ -129,6 +129,7 @@ from cadgen.params.solids import MIN_WALL, GroundParameters, ShellParameters, So
 from cadgen.params.machine import (DEFAULT_BUILD_VOLUME, PROCESSES, MachineParameters,
                                    ManufacturingParameters, PrickingMachineParameters,
                                    PrickingShaftDiameters, ShaftDiameters)
+from cadgen.params.dynamics import DynamicsParameters
 
 __all__ = [
     "ParameterError",
@@ -163,6 +164,7 @@ __all__ = [
     "GroundParameters",
     "SolidsParameters",
     "MachineParameters",
+    "DynamicsParameters",
     "ManufacturingParameters",
     "ShaftDiameters",
     "PrickingMachineParameters",

@@ -19,6 +19,7 @@ from cadgen.params.cutting import PlantingCuttingParameters
 from cadgen.params.scene import SceneParameters
 from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
 from cadgen.params.machine import MachineParameters, ManufacturingParameters
+from cadgen.params.dynamics import DynamicsParameters
 from cadgen.params._tables import NAME_MAX_LENGTH, NAME_PATTERN, _list_to_tuple, _no_repeats, _Table
 
 __all__ = [
@@ -226,4 +227,5 @@ class PlantingParameters(_Table):
     solids: SolidsParameters = SolidsParameters()
     machine: MachineParameters = MachineParameters()
     manufacturing: ManufacturingParameters = ManufacturingParameters()
+    dynamics: DynamicsParameters = DynamicsParameters()
     scene: SceneParameters = SceneParameters()

@@ -18,7 +18,7 @@ __all__ = ["EFFECTS", "CASES", "Effect", "SceneParameters", "PRESETS", "apply_pr
 
 
 EFFECTS = ("metrics", "curves", "teeth", "meshing", "cam", "solids", "arm_interference",
-           "ground_clearance", "dxf", "stl", "plots", "report")
+           "ground_clearance", "dynamics", "dxf", "stl", "plots", "report")
 """Every effect a scene may ask for, in the order a build reports them."""
 
 CASES = ("field", "bench")
@@ -27,7 +27,7 @@ CASES = ("field", "bench")
 clearance)."""
 
 Effect = Literal["metrics", "curves", "teeth", "meshing", "cam", "solids", "arm_interference",
-                 "ground_clearance", "dxf", "stl", "plots", "report"]
+                 "ground_clearance", "dynamics", "dxf", "stl", "plots", "report"]
 
 
 class SceneParameters(_Table):

@@ -79,8 +79,10 @@ class _Beside:
 
 def _shows_gears(figure: str) -> bool:
     """A figure that shows the gears, cut after the fork: the gear pairs' are drawn by the
-    worker from data sent to it; the assembly view, which needs every part's mesh, here."""
-    return figure == "assembly.png" or figure.startswith("gears-")
+    worker from data sent to it; the assembly view, which needs every part's mesh, here.
+    The dynamics' figures too: the dynamics run after the fork (on the solids' masses), so
+    only this process has them."""
+    return figure == "assembly.png" or figure.startswith(("gears-", "dynamics-"))
 
 
 def start_beside(run, functions):

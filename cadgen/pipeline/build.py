@@ -22,6 +22,8 @@ parts               the solids: split housings (base and cover with bearing
                     checks
 arm_interference    FCL sweep of arm against arm (planting)
 ground_clearance    FCL sweep of every housing against the ground
+dynamics            inverse dynamics over a carrier turn (planting): drive torque,
+                    bearing and mesh forces, shaking force (:mod:`cadgen.dynamics`)
 plots               PNG pictures of what ran
 ==================  ==========================================================
 
@@ -329,6 +331,29 @@ def _ground_clearance(run):
                             run.values["metrics"])
 
 
+def _dynamics(run):
+    """Inverse dynamics over a carrier turn (planting): masses from the solids when the parts
+    and the gears were built, else estimated from the parameters."""
+    from cadgen.dynamics import planting_dynamics
+
+    masses, source, skipped = None, "estimated", ()
+    if run.status("parts") == "ok" and run.status("teeth") == "ok":
+        from cadgen.dynamics.mass import solid_mass_properties
+
+        if run._beside is not None:     # the worker's meshes of the gearless parts, not again
+            from cadgen.pipeline.beside import take_meshes
+
+            take_meshes(run, run._beside)
+        masses, skipped = solid_mass_properties(run.values["parts"])
+        source = "solids"
+    cam = run.values.get("cam") if run.status("cam") == "ok" else None
+    events = run.values["metrics"].events if run.soil and run.status("metrics") == "ok" \
+        else None
+    return planting_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
+                             cam=cam, events=events, masses=masses, mass_source=source,
+                             skipped=skipped)
+
+
 def _plots(run):
     from cadgen.pipeline.figures import build_figures
 
@@ -338,7 +363,8 @@ def _plots(run):
 STAGE_FUNCTIONS = {"kinematics": _kinematics, "metrics": _metrics, "drivetrain": _drivetrain,
                    "teeth": _teeth, "cam": _cam,
                    "parts": _parts, "arm_interference": _arm_interference,
-                   "ground_clearance": _ground_clearance, "plots": _plots}
+                   "ground_clearance": _ground_clearance, "dynamics": _dynamics,
+                   "plots": _plots}
 
 
 # --------------------------------------------------------------------------- the build

@@ -46,6 +46,12 @@ def figure_jobs(run) -> dict:
 
         jobs["assembly.png"] = lambda: _assembly(run)
         jobs.update(housing_figure_jobs(values["parts"].housings, values.get("drivetrain")))
+    if "dynamics" in ok:
+        from cadgen.dynamics import dynamics_report
+        from cadgen.report.plots.dynamics import dynamics_figure_jobs
+
+        events = values["metrics"].events if run.soil and "metrics" in ok else None
+        jobs.update(dynamics_figure_jobs(dynamics_report(values["dynamics"], params), events))
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:
         from cadgen.report.plots.parts import clearance_figure

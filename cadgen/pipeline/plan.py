@@ -26,6 +26,10 @@ EFFECT_STAGES = {
     "solids": ("cam", "parts"),       # gears among the solids when "teeth" runs too
     "arm_interference": ("cam", "parts", "arm_interference"),
     "ground_clearance": ("metrics", "parts", "ground_clearance"),
+    # the drive's input, the journals and the duckbill's spring are the drivetrain's; the
+    # soil level and the seedling's release the metrics' and the cam's; the masses come from
+    # the solids when the scene builds them (else estimated), never built for the dynamics
+    "dynamics": ("metrics", "cam", "drivetrain", "dynamics"),
     "dxf": (),                 # the cutting files of the teeth and cam that run (both if alone)
     "stl": ("cam", "parts"),
     # the trajectory, attitude and speed figures are drawn from the metrics' events (soil
@@ -47,6 +51,7 @@ STAGE_NEEDS = {
     "parts": ("metrics", "drivetrain"),
     "arm_interference": ("parts",),
     "ground_clearance": ("parts",),
+    "dynamics": ("kinematics", "drivetrain"),
     "plots": ("kinematics",),
 }
 STAGE_ORDER = tuple(STAGE_NEEDS)
@@ -55,6 +60,8 @@ STAGE_ORDER = tuple(STAGE_NEEDS)
 NOT_APPLICABLE = {
     ("pricking", "cam"): "the pricking mechanism has no cam",
     ("pricking", "arm_interference"): "the pricking mechanism has a single arm",
+    ("pricking", "dynamics"): "dynamics is not modelled for the pricking mechanism (only the "
+                              "planting mechanism's drive torque and forces are computed)",
     ("bench", "ground_clearance"): "a bench run has no soil",
 }
 

@@ -27,7 +27,8 @@ STAGE_IMPORTS = {
     "parts": ("trimesh", "manifold3d", "cadgen.solids.{mechanism}", "cadgen.solids.outcome"),
     "arm_interference": ("fcl", "cadgen.pipeline.clearances"),
     "ground_clearance": ("fcl", "cadgen.pipeline.clearances"),
-    "plots": ("cadgen.report.plots.{mechanism}", "cadgen.report.plots.parts",
+    "dynamics": ("cadgen.dynamics", "cadgen.dynamics.mass", "cadgen.machine.follower"),
+    "plots": ("cadgen.report.plots.{mechanism}", "cadgen.report.plots.dynamics", "cadgen.report.plots.parts",
               "cadgen.report.plots.housings", "cadgen.report.plots.cam"),
 }
 

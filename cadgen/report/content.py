@@ -185,6 +185,12 @@ def assemble_report(run, set_aside: dict) -> dict:
     if sweeps:
         report["sweep"] = sweeps
         _replace_kinematic_estimates(report, sweeps)
+    if "dynamics" in ok:
+        from cadgen.dynamics import dynamics_report
+
+        report["dynamics"] = dynamics_report(values["dynamics"], params)
+    elif "dynamics" in set_aside:   # said, never a silent zero
+        report["dynamics"] = {"modelled": False, "reason": set_aside["dynamics"]}
     report["warnings"] = [p.as_dict() for p in getattr(run, "warnings", [])]
     report["check_warnings"] = check_warnings(report)
     report["accuracy_achieved"] = accuracy_achieved(params, report, values, ok)
@@ -286,6 +292,12 @@ def failures(report: dict) -> list:
         for problem in rim["problems"]:
             if problem["code"] in FAILING_RIM_PROBLEMS:
                 out.append(f"gear hub {rim['gear']}: [{problem['code']}] {problem['message']}")
+    dynamics = report.get("dynamics", {})
+    for reason in dynamics.get("outside_validity", []):
+        out.append(f"dynamics: {reason}")
+    if dynamics.get("modelled") and dynamics["energy_balance_max_rel"] > 1e-6:
+        out.append(f"dynamics: the power balance and Newton-Euler differ by "
+                   f"{dynamics['energy_balance_max_rel']:.2g} of the peak power")
     for failure in report.get("solids", {}).get("overlaps", {}).get("failures", []):
         out.append(f"parts overlap at the assembly pose: {failure}")
     for row in report.get("solids", {}).get("enclosure", []):

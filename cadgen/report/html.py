@@ -317,6 +317,10 @@ _CAPTIONS = {
     "loop": "Needle-tip loop and linkage",
     "ratio": "Transmission ratios",
     "field_paths": "Field paths per inclination",
+    "dynamics-torque": "Dynamics: input torque and power over a carrier turn",
+    "dynamics-meshes": "Dynamics: gear mesh normal forces",
+    "dynamics-bearings": "Dynamics: bearing loads",
+    "dynamics-shaking": "Dynamics: shaking force on the frame (polar)",
 }
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["summary_text", "format_metrics_table", "format_gear_table", "format_cam",
+__all__ = ["summary_text", "format_metrics_table", "format_gear_table", "format_cam", "format_dynamics",
            "format_duckbill",
            "format_solids", "format_machine", "format_clearances", "format_stages", "format_verdict"]
 
@@ -50,8 +50,24 @@ def summary_text(report: dict) -> str:
     if "machine" in report:
         sections.append(format_machine(report["machine"], report.get("bom"),
                                        (report.get("assembly") or {}).get("axial")))
+    if "dynamics" in report:
+        sections.append(format_dynamics(report["dynamics"]))
     sections.append(format_stages(report))
     return "\n\n".join(sections)
+
+
+def format_dynamics(dynamics: dict) -> str:
+    """One line: the input torque over a carrier turn, or why there is none."""
+    if not dynamics.get("modelled"):
+        return f"dynamics: not modelled ({dynamics['reason']})"
+    torque = dynamics["summary"]["input_torque_nm"]
+    motor = dynamics["motor"]
+    return (f"dynamics ({dynamics['mass_properties_source']} masses, load case "
+            f"{dynamics['load_case']}, {dynamics['carrier_speed_rpm']:g} r/min): input torque "
+            f"peak {torque['peak']:.3g} N m, RMS {torque['rms']:.3g}, mean {torque['mean']:.3g} "
+            f"at {dynamics['input_speed_rpm']:g} r/min; motor {motor['rated_torque_nm']:.3g} N m "
+            f"{motor['rated_power_w']:.3g} W; energy balance "
+            f"{dynamics['energy_balance_max_rel']:.1e}")
 
 
 def format_stages(report: dict) -> str:
