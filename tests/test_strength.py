@@ -287,3 +287,32 @@ def test_a_gear_below_its_limit_fails_the_build_and_the_gear_material_names_the_
     assert design_fits(params).material("gear").process == "laser-cut plate"
     assert set(GEAR_MATERIALS) == set(MachineParameters.model_fields["gear_material"]
                                       .annotation.__args__[0].__args__)
+
+
+def test_the_dynamics_forces_reach_the_strength_at_the_carrier_angle_of_each_arm():
+    """The planting non-circular pair's cycle parameter is the central gear's polar angle of
+    the contact, which is the carrier angle (gearbox 2 turns +phi, the central gear -phi
+    relative to it, the contact stays on the line of centres): arm 2's copy is half a turn on.
+    The forces are the dynamics' times the service factor, both arms' copies in one cycle."""
+    from cadgen.machine.gear_strength import dynamics_mesh_forces
+    from cadgen.params import load_params
+    from cadgen.pipeline.build import STAGE_FUNCTIONS, _Build
+
+    from helpers import REFERENCE
+
+    params = load_params(REFERENCE)
+    run = _Build(params, ["kinematics", "metrics", "cam", "drivetrain", "dynamics"], None)
+    run.effects, run.case = ["dynamics"], "field"
+    run.run(STAGE_FUNCTIONS)
+    result = run.values["dynamics"]
+    forces = dynamics_mesh_forces(result, 1.5)
+    pose, force = forces["central", "intermediate"]
+    n = len(result.phi)
+    expected = np.concatenate([np.mod(result.phi, 2 * np.pi), np.mod(result.phi + np.pi, 2 * np.pi)])
+    gap = np.angle(np.exp(1j * (pose - expected)))
+    assert np.abs(gap).max() < 1e-9
+    arms = [result.meshes["central", "intermediate", side].normal_force_n for side in (1, 2)]
+    np.testing.assert_array_equal(force, 1.5 * np.concatenate(arms))
+    # the drive's pairs are one for the machine; every mesh of the train is there
+    assert len(forces["input gear 2", "transmission driven gear"][0]) == n
+    assert {pair for pair in forces} == {key[:2] for key in result.meshes}

@@ -67,6 +67,8 @@ class DynamicsResult:
     friction_rounds: int = 0
     sweep: list = field(default_factory=list)   # [(rpm, peak |T|, rms T)]
     invalid: list = field(default_factory=list)  # what falls outside the model's validity
+    #: the gears' tooth strength under these loads (machine.gear_strength), when cut
+    strength: object = None
 
     def stats(self, values) -> dict:
         values = np.asarray(values, dtype=float)

@@ -32,7 +32,8 @@ from cadgen.gears.gear_materials import gear_material
 from cadgen.gears.strength import MeshGear, MeshLoad, RackProfile, StrengthFactors, mesh_strength
 from cadgen.gears.strength_summary import train_strength_summary
 
-__all__ = ["train_strength", "contact_curvatures", "STRENGTH_POSES", "ASSUMED_LOAD"]
+__all__ = ["train_strength", "contact_curvatures", "dynamics_mesh_forces", "STRENGTH_POSES",
+           "ASSUMED_LOAD", "DYNAMICS_LOAD"]
 
 #: Poses of a mesh's cycle the strength is evaluated at (uniform): 0.25 deg of the carrier for
 #: the planting non-circular pair; cheap (vectorised), and the curvature's extremes are broad.
@@ -113,6 +114,36 @@ def _noncircular_mesh(stage, names, materials, idlers, loads, pose, curvatures):
     return tuple(gears), force
 
 
+#: How the report names the dynamics' loads.
+DYNAMICS_LOAD = ("dynamics: each mesh's normal force over the carrier turn (both arms' copies), "
+                 "times machine.service_factor for shocks")
+
+
+def dynamics_mesh_forces(result, service_factor: float) -> dict:
+    """The dynamics' tooth forces as :func:`train_strength`'s ``mesh_forces``: ``{(drive,
+    driven): (pose, force)}``, each pair's poses over the carrier turn of every copy (both arms'
+    gears are one part, so a gear must endure both cycles), the force times
+    ``service_factor`` (the dynamics has no shocks: the design load's factor stands for them).
+
+    A pair's pose is its cycle's parameter: for the planting non-circular pair the central
+    gear's polar angle of the contact, ``t`` of ``r1(t)``, which is the carrier angle (arm 2
+    half a turn on); a circular pair's geometry is the same at every pose, which is taken as
+    the carrier angle of arm 1's cycle likewise."""
+    phi = np.asarray(result.phi, dtype=float)
+    out = {}
+    for (drive, driven, side), mesh in result.meshes.items():
+        if mesh.pitch_parameter is not None:
+            pose = np.mod(np.asarray(mesh.pitch_parameter, dtype=float), 2 * np.pi)
+        else:
+            pose = np.mod(phi + (np.pi if side == 2 else 0.0), 2 * np.pi)
+        force = service_factor * np.asarray(mesh.normal_force_n, dtype=float)
+        if (drive, driven) in out:
+            before = out[drive, driven]
+            pose, force = np.concatenate([before[0], pose]), np.concatenate([before[1], force])
+        out[drive, driven] = (pose, force)
+    return out
+
+
 def train_strength(params, design, train, mesh_forces: dict | None = None,
                    poses: int = STRENGTH_POSES, factors: StrengthFactors = StrengthFactors()):
     """Every gear's tooth strength over its meshes' cycles, checked against ``[machine]``.
@@ -162,7 +193,7 @@ def train_strength(params, design, train, mesh_forces: dict | None = None,
                                              curvatures)
         source = ASSUMED_LOAD
         if given is not None:
-            force, source = np.asarray(given[1], dtype=float), "dynamics (mesh_forces)"
+            force, source = np.asarray(given[1], dtype=float), DYNAMICS_LOAD
         sources.add(source)
         rack = RackProfile(system.pressure_angle, system.addendum, system.dedendum,
                            system.tip_radius)

@@ -349,9 +349,18 @@ def _dynamics(run):
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
     events = run.values["metrics"].events if run.soil and run.status("metrics") == "ok" \
         else None
-    return planting_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
-                             cam=cam, events=events, masses=masses, mass_source=source,
-                             skipped=skipped)
+    result = planting_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
+                               cam=cam, events=events, masses=masses, mass_source=source,
+                               skipped=skipped)
+    train = run.values.get("teeth") if run.status("teeth") == "ok" else None
+    if train is not None and train.stages and result.meshes:
+        # the teeth under the computed loads: what the report's strength then says
+        from cadgen.machine.gear_strength import dynamics_mesh_forces, train_strength
+
+        result.strength = train_strength(
+            run.params, run.values["kinematics"], train,
+            dynamics_mesh_forces(result, run.params.machine.service_factor))
+    return result
 
 
 def _plots(run):

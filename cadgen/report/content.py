@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -153,7 +154,12 @@ def assemble_report(run, set_aside: dict) -> dict:
     if "teeth" in ok:
         from cadgen.gears.trains import train_report
 
-        report["gear_train"] = train_report(values["teeth"])
+        train = values["teeth"]
+        strength = getattr(values.get("dynamics"), "strength", None) if "dynamics" in ok \
+            else None
+        if strength is not None:   # the teeth under the dynamics' loads, not the assumed one
+            train = dataclasses.replace(train, strength=strength)
+        report["gear_train"] = train_report(train)
     if "cam" in ok:
         from cadgen.cam.design import cam_section
 
