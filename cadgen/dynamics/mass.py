@@ -116,15 +116,17 @@ def solid_mass_properties(outcome) -> tuple:
             body = body_of_part(host or part.name, second)
             if body is None:
                 continue
-            if part.name not in own:
+            # a bought item's mesh is one per catalogue size, shared by every item of that size
+            key = ("bought", id(part.mesh)) if host else part.name
+            if key not in own:
                 try:
                     density = STEEL_DENSITY if host else (
                         outcome.density or fits.material(part.kind).density)
-                    own[part.name] = mass_properties(part.mesh, density)
+                    own[key] = mass_properties(part.mesh, density)
                 except (SolidError, FitError) as error:
-                    own[part.name] = None
+                    own[key] = None
                     skipped.append((part.name, str(error)))
-            props = own[part.name]
+            props = own[key]
             if props is None:
                 continue
             pose = assembly.body_pose(body_name, phase) @ part.local(phase)
