@@ -38,6 +38,8 @@ def test_writes_report_and_plots(params, tmp_path):
                              "gearbox1-cover.stl", "gearbox2-base.stl", "gearbox2-cover.stl",
                              *(f"shaft-{axis}.stl" for axis in ("O", "A", "B", "C", "C2", "D", "E",
                                                                 "S", "input")),
+                             # side 2's C2: its central-gear keyseat half a turn from side 1's
+                             "shaft-C2-arm2.stl",
                              "ground.stl", "idler-1.stl", "idler-2.stl", "intermediate.stl",
                              "planet-gear-E.stl", "planter-shell.stl", "sun.stl",
                              "train-1-planet.stl", "frame-base.stl", "frame-cover.stl",

@@ -107,7 +107,10 @@
     model.updateMatrixWorld(true);
     model.traverse(function (node) {
       if (!node.isMesh) return;
-      var name = node.name || (node.parent && node.parent.name) || "";
+      // the file's node name (three.js keeps it in userData: its own name drops the "/" of
+      // "bought/...")
+      var name = node.userData.name || node.name ||
+        (node.parent && (node.parent.userData.name || node.parent.name)) || "";
       // the GLB carries a material per kind of part (housings and soil see-through): keep it,
       // drawn from both sides since a housing's cavity faces inwards
       if (node.material) node.material.side = T.DoubleSide;
