@@ -10,7 +10,9 @@ inner ring's speed relative to the outer ring (r/min). The gears of these
 mechanisms are spur gears, so the bearings take no axial load and P = Fr
 (ISO 281 X = 1, Y = 0). The radial load is taken as acting all revolution at its
 largest value over the cycle (the design load times the service factor), which is
-conservative: the soil load acts only while the tool is in the ground.
+conservative: the soil load acts only while the tool is in the ground. Where the dynamics
+ran, P is ISO 281's cycle-equivalent load over the turn instead
+(:func:`cadgen.machine.cycle_loads.equivalent_load`).
 """
 
 from __future__ import annotations

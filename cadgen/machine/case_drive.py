@@ -17,7 +17,7 @@ import math
 
 from cadgen.machine.catalogue import clearance_hole
 
-__all__ = ["case_drive", "CHAIN", "SPROCKET_MIN_TEETH", "BRACKET_PLATE", "MOUNT_BOLT"]
+__all__ = ["case_drive", "pricking_case_drive", "CHAIN", "SPROCKET_MIN_TEETH", "BRACKET_PLATE", "MOUNT_BOLT"]
 
 #: ISO 606 roller chain 08B-1: pitch p, roller diameter d1, inner width b1, sprocket width.
 CHAIN = {"designation": "08B-1", "pitch": 12.7, "roller": 8.51, "inner_width": 7.75,
@@ -75,3 +75,25 @@ def case_drive(sun_diameter: float, hub_depth: float, stub: float, case_torque_n
                     "mount_holes": [(sx * holes, sy * holes) for sx, sy in
                                     ((1, 1), (-1, 1), (-1, -1), (1, -1))]},
     }
+
+
+def pricking_case_drive(params, design, shafts, loads) -> tuple:
+    """The bracket holding the sun's stub and the sprocket driving the gear case
+    (:func:`cadgen.machine.case_drive.case_drive`), and its screws' check. The case's torque:
+    the moments about O on it, the sun's reaction and the tool's load at its largest reach,
+    ``T_case = T_sun + F (2 a + l)``."""
+    from cadgen.machine.fastening import flange_problems
+    from cadgen.machine.loads import design_load
+
+    sun = next(s for s in shafts if s.name == "sun")
+    if sun.coupling_key is None:
+        return None, []
+    link = design.linkage
+    torque = loads["sun"].torque_nmm + design_load(params.machine) * (2 * link.a + link.l)
+    held = case_drive(sun.diameter, sun.coupling_key.hub_depth, sun.extends_below, torque,
+                      params.field.carrier_speed_rpm, params.housing.axial_gap)
+    screws = dict(held["sprocket"])
+    found = flange_problems("the gear case", "its sprocket", torque, screws)
+    held["sprocket"].update({k: screws[k] for k in ("stress_area_mm2", "bolt_shear_mpa",
+                                                    "bolt_shear_allow_mpa")})
+    return held, found

@@ -26,9 +26,12 @@ from dataclasses import dataclass
 from kinematics.errors import Problem
 
 from cadgen.gears.circular import DRIVE_SLEEVE_DIAMETER, planting_modules
+from cadgen.gears.drive import DEDENDUM_MODULES, RIM_MODULES
 from cadgen.machine.bearings import journal_bore, select_bearing
+from cadgen.machine.case_drive import pricking_case_drive
 from cadgen.machine.catalogue import (CatalogueError, bearings, bearings_with_bore,
                                       preferred_diameters)
+from cadgen.machine.cycle_loads import ASSUMED_TIP_FORCE, cycle_size, with_cycles
 from cadgen.machine.fits import process_fits
 from cadgen.machine.fastening import coupling_key, flange_problems, free_bearing
 from cadgen.machine.fixings import arm_fixings, cam_bore_problems, fixings_report
@@ -37,8 +40,8 @@ from cadgen.machine.layouts import (HOLLOW_WALL_MIN, _mount_fields, carry_flange
 from cadgen.machine.model import BearingSeat, Drivetrain, GearMount, HousingStack, Shaft
 from cadgen.machine.retention import drivetrain_retention
 from cadgen.machine.shafts import (RULES as SHAFT_RULES, beam_reactions, choose_diameter,
-                                   hub_key, key_pressure, max_bending, required_diameter,
-                                   shaft_core)
+                                   hollow_required, hub_key, key_pressure, max_bending,
+                                   required_diameter, shaft_core)
 
 __all__ = ["drivetrain", "drivetrain_report", "RULES", "MAX_ITERATIONS"]
 
@@ -70,6 +73,8 @@ class _Sized:
     bearings: tuple               # (floor, roof): (Bearing, life, passed)
     overhang: float               # height of the external load from the cavity floor (or None)
     bore: float = 0.0             # a hollow shaft's bore
+    peak: tuple = ()              # over the dynamics' cycle: each bearing's peak load (N)
+    carried: tuple | None = None  # (housing, (n, 2) N): the roof bearing's load on that housing
 
 
 # ------------------------------------------------------------------ sizing
@@ -82,24 +87,6 @@ def _span(axis, cavities, base, widths) -> tuple:
         return height + w0 / 2, height + w0 + w1 / 2
     top = axis.roof_housing or h
     return -widths[0] / 2, base[top] - base[h] + cavities[top].height + widths[1] / 2
-
-
-def _hollow_required(bending: float, torque: float, bore: float, machine) -> float:
-    """The least outside diameter (mm) of a tube of ``bore`` whose largest shear stress under
-    bending and torsion, ``16 d sqrt(M^2 + T^2) / (pi (d^4 - bore^4))``, stays within ``tau / S``
-    (``tau = yield / 2``), by bisection (the stress falls as ``d`` grows)."""
-    tau = machine.shaft_yield_mpa / 2 / machine.shaft_safety_factor
-    moment = math.hypot(bending, torque)
-
-    def stress(d):
-        return 16 * d * moment / (math.pi * (d ** 4 - bore ** 4))
-    low, high = bore + 1e-6, bore + 200.0
-    if moment == 0.0:
-        return bore
-    for _ in range(100):
-        middle = 0.5 * (low + high)
-        low, high = (middle, high) if stress(middle) > tau else (low, middle)
-    return high
 
 
 def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
@@ -115,11 +102,26 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
     if axis.loads.external is not None:
         overhang = axis.external_above(walls, base) - base[h]
         loads.append((overhang, axis.loads.external[1]))
-    bending = max_bending(z1, z2, loads)
+    cycle, peak, carried = axis.loads.cycle, (), None
+    if cycle is not None:   # the dynamics' forces at every pose (cycle_loads), not one bound
+        heights = {_mount_fields(m)[0]: z for m, (z, _) in zip(axis.mounts, loads)}
+        through = inner.carried[1] if inner is not None and inner.carried is not None \
+            and inner.carried[0] == axis.carries else None
+        # a carried housing's loads reach the shaft through that housing: at its mid-height
+        at = overhang if axis.carries is None else \
+            base[axis.carries] - base[h] + cavities[axis.carries].height / 2
+        bending, reactions, peak, forces = cycle_size(axis, z1, z2, heights, at,
+                                                      machine.service_factor, through)
+        reactions, peak = tuple(float(v) for v in reactions), tuple(float(v) for v in peak)
+        if axis.roof_housing is not None:
+            carried = (axis.roof_housing, -forces[1])
+    else:
+        bending = max_bending(z1, z2, loads)
+        reactions = tuple(abs(v) for v in beam_reactions(z1, z2, loads))
     bore = 0.0
     if axis.inside is not None and inner is not None:
         bore = inner.diameter + clearance
-        required = _hollow_required(bending, axis.loads.torque_nmm, bore, machine)
+        required = hollow_required(bending, axis.loads.torque_nmm, bore, machine)
         # the smallest bearing bore whose tube (under its keyseat) is strong enough and whose
         # keys carry the torque within key_pressure_mpa: a hollow shaft carries a housing's
         fits_tube = [b for b in preferred_diameters()
@@ -136,7 +138,6 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
             strong = choose_diameter(required) or preferred_diameters()[-1]
             d = next((b for b in preferred_diameters()
                       if b >= strong and _keys_hold(axis, b, machine)), strong)
-    reactions = tuple(abs(v) for v in beam_reactions(z1, z2, loads))
     bore_j = journal_bore(d)
     if axis.roof_pair:   # a pair is two of one bearing: chosen for the larger reaction
         pick = select_bearing(bore_j, max(reactions), axis.loads.speed_rpm,
@@ -153,7 +154,7 @@ def _size(axis, cavities, walls, base, widths, given, machine, inner=None,
         chosen = tuple(select_bearing(bore_j, load, axis.loads.speed_rpm,
                                       machine.bearing_life_min_h, min_width=width)
                        for load, width in zip(reactions, widths))
-    return _Sized(d, required, bending, reactions, chosen, overhang, bore)
+    return _Sized(d, required, bending, reactions, chosen, overhang, bore, peak, carried)
 
 
 def _keys_hold(axis, d: float, machine) -> bool:
@@ -269,28 +270,6 @@ def _mounts(axis, d, fits, machine, report: bool, base=None) -> tuple:
     return tuple(mounts), problems
 
 
-def _pricking_case_drive(params, design, shafts, loads) -> tuple:
-    """The bracket holding the sun's stub and the sprocket driving the gear case
-    (:func:`cadgen.machine.case_drive.case_drive`), and its screws' check. The case's torque:
-    the moments about O on it, the sun's reaction and the tool's load at its largest reach,
-    ``T_case = T_sun + F (2 a + l)``."""
-    from cadgen.machine.case_drive import case_drive
-    from cadgen.machine.loads import design_load
-
-    sun = next(s for s in shafts if s.name == "sun")
-    if sun.coupling_key is None:
-        return None, []
-    link = design.linkage
-    torque = loads["sun"].torque_nmm + design_load(params.machine) * (2 * link.a + link.l)
-    held = case_drive(sun.diameter, sun.coupling_key.hub_depth, sun.extends_below, torque,
-                      params.field.carrier_speed_rpm, params.housing.axial_gap)
-    screws = dict(held["sprocket"])
-    found = flange_problems("the gear case", "its sprocket", torque, screws)
-    held["sprocket"].update({k: screws[k] for k in ("stress_area_mm2", "bolt_shear_mpa",
-                                                    "bolt_shear_allow_mpa")})
-    return held, found
-
-
 #: Rounds of drive redesign round its shafts' hubs (each can only grow the gears).
 DRIVE_ROUNDS = 4
 
@@ -304,8 +283,9 @@ def _hub_diameter(d: float, face: float) -> float:
     return d + 2 * key.hub_depth if key is not None else d
 
 
-def _drive_round_hubs(params, design, axes, sized, drive):
-    """The drive redesigned round the hubs of the shafts just sized, or None if it fits them."""
+def _drive_round_hubs(params, design, axes, sized, drive, keep=False):
+    """The drive redesigned round the hubs of the shafts just sized, or None if it fits them
+    (``keep``: None while its gears' rims clear them, rather than the least drive that does)."""
     from cadgen.gears.circular import planting_drive
 
     by_name = {axis.name: size for axis, size in zip(axes, sized) if axis.side == 1}
@@ -313,6 +293,9 @@ def _drive_round_hubs(params, design, axes, sized, drive):
     hubs = tuple(_hub_diameter(by_name[name].diameter, face)
                  for name in ("input", "O", "input", "S"))
     module_c = planting_modules(design, params.pitch_curve.teeth, params.gears.circular_module)[1]
+    if keep and all(z * drive.module_1 / 2 - (DEDENDUM_MODULES + RIM_MODULES) * drive.module_1
+                    >= hub / 2 - 1e-9 for z, hub in zip(drive.teeth, hubs)):
+        return None   # kept while it clears them: sized again, the shafts only shrank
     need = planting_drive(design, module_c, params.gears.circular_module,
                           params.field.carrier_speed_rpm, params.gears.pressure_angle_rad,
                           hubs=hubs)
@@ -353,7 +336,7 @@ def _shaft_problems(axis, sized, given, machine, both_sides) -> list:
     return problems
 
 
-def drivetrain(params, design, cam=None) -> Drivetrain:
+def drivetrain(params, design, cam=None, *, cycles=None, drive=None) -> Drivetrain:
     """Every shaft, bearing seat and housing stack of a mechanism, with the rules used.
 
     Parameters
@@ -366,6 +349,12 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
     cam : cadgen.cam.design.CamDesign, optional
         The planting cam: its screws to gearbox 2 are sized round its contour
         (:func:`cadgen.machine.fixings.arm_fixings`); without it the cam has no fixing.
+    cycles : dict, optional
+        ``{axis: cycle_loads.CycleLoads}``: the dynamics' loads over the turn, which size those
+        axes instead of the assumed tip force (:mod:`cadgen.machine.cycle_loads`).
+    drive : cadgen.gears.drive.DriveDesign, optional
+        The planting drive to start from (the one ``cycles`` were computed with); with
+        ``cycles`` it is kept while its gears clear the shafts' hubs.
 
     Returns
     -------
@@ -376,22 +365,24 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
     machine = params.machine
     fits = process_fits(params.manufacturing.process)
     if params.mechanism == "planting":
-        axes, cavities, loads, bases, drive = planting_axes(params, design)
+        axes, cavities, loads, bases, drive = planting_axes(params, design, drive)
     elif params.mechanism == "pricking":
         axes, cavities, loads, bases, drive = pricking_axes(params, design)
     else:
         raise ValueError(f"no drivetrain for mechanism {params.mechanism!r}")
     given = machine.shafts.given()
+    axes = with_cycles(axes, cycles, machine.service_factor)
     sized, walls, iterations, converged = _fixed_point(axes, cavities, given, machine, bases,
                                                        fits.running_clearance)
     for _ in range(DRIVE_ROUNDS if drive is not None else 0):
         # the drive's gears sit on O, the sleeve and the input: their rims must clear the hubs
         # of the shafts just sized; a larger gear changes the loads, so size again
-        bigger = _drive_round_hubs(params, design, axes, sized, drive)
+        bigger = _drive_round_hubs(params, design, axes, sized, drive, keep=cycles is not None)
         if bigger is None:
             break
         drive = bigger
         axes, cavities, loads, bases, drive = planting_axes(params, design, drive)
+        axes = with_cycles(axes, cycles, machine.service_factor)
         sized, walls, iterations, converged = _fixed_point(axes, cavities, given, machine,
                                                            bases, fits.running_clearance)
     base = bases(walls)
@@ -402,6 +393,7 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
     for axis, size in zip(axes, sized):
         report = axis.side == 1
         both = axis.name in names_with_sides
+        source = axis.loads.cycle.source if axis.loads.cycle is not None else ASSUMED_TIP_FORCE
         d = size.diameter
         mounts, mount_problems = _mounts(axis, d, fits, machine, report, base)
         if report:
@@ -414,10 +406,11 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
                 break   # the pair is one seat of two bearings
             bearing, life, _ = size.bearings[k]
             through = axis.floor_through if wall == "floor" else axis.roof_through
-            load, life_seat = size.reactions[k], life
+            load, life_seat, worst = size.reactions[k], life, k
             if axis.roof_pair:   # the pair's worse bearing speaks for the seat
-                k_worst = max((0, 1), key=lambda j: size.reactions[j])
-                load, life_seat = size.reactions[k_worst], size.bearings[k_worst][1]
+                worst = max((0, 1), key=lambda j: size.reactions[j])
+                load, life_seat = size.reactions[worst], size.bearings[worst][1]
+            peak = size.peak[worst] if size.peak else None
             # a seat in another housing sits on this axis there: gearbox 2's is centred on C
             xy = axis.xy if housing == axis.housing else (0.0, 0.0)
             seats.append(BearingSeat(
@@ -425,7 +418,7 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
                 bearing.outside + fits.seat_allowance(bearing.outside), through,
                 d + fits.running_clearance if through else 0.0, load,
                 axis.loads.speed_rpm, life_seat, machine.bearing_life_min_h,
-                2 if axis.roof_pair else 1))
+                2 if axis.roof_pair else 1, source, peak))
         ends = None
         if axis.roof_housing is not None:   # from its floor seat to the other housing's roof
             top = axis.roof_housing
@@ -452,7 +445,7 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
                             axis.loads.speed_rpm, mounts, tuple(seats),
                             float(axis.below(d)) if axis.floor_through else 0.0,
                             axis.above if axis.roof_through else 0.0, axis.note,
-                            size.bore, ends, flange, coupling))
+                            size.bore, ends, flange, coupling, source, source))
     sleeve = next((s for s in shafts if s.name == "S"), None)
     if sleeve is not None and sleeve.diameter > DRIVE_SLEEVE_DIAMETER + 1e-9:
         problems.append(Problem("machine.shafts.S", "sleeve_beyond_drive",
@@ -470,7 +463,7 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
         fixings.update({"duckbill": duckbill} if duckbill is not None else {})
     held = None
     if params.mechanism == "pricking":
-        held, found = _pricking_case_drive(params, design, shafts, loads)
+        held, found = pricking_case_drive(params, design, shafts, loads)
         problems += found
     if not converged:
         problems.append(Problem("machine", "drivetrain_not_settled",
@@ -489,7 +482,8 @@ def drivetrain(params, design, cam=None) -> Drivetrain:
                            "carrier_speed_rpm": params.field.carrier_speed_rpm,
                            "shoulder_min_mm": SHOULDER_MIN, "shoulder_ratio": SHOULDER_RATIO,
                            "catalogue_bearings": len(bearings())},
-             "loads": next(iter(loads.values())).formulas,
+             "loads": next((a.loads.formulas for a in axes if a.loads.cycle is not None),
+                           next(iter(loads.values())).formulas),
              "fits": fits.as_dict(), "iterations": iterations, "converged": converged,
              "overhangs_mm": {f"{a.name}-side{a.side}": s.overhang for a, s in zip(axes, sized)
                               if s.overhang is not None}}
@@ -558,6 +552,7 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
             "speed_rpm": shaft.speed_rpm, "length_mm": _length(shaft, stack),
             "extends_below_mm": shaft.extends_below, "extends_above_mm": shaft.extends_above,
             "strength_passed": shaft.strength_passed, "note": shaft.note, "hubs": hubs,
+            "load_source": shaft.load_source, "sized_from": shaft.sized_from,
             "bore_mm": shaft.bore, "flange": shaft.flange,
             "coupling_key": None if shaft.coupling_key is None else {
                 "designation": shaft.coupling_key.designation,
@@ -574,7 +569,8 @@ def drivetrain_report(drivetrain: Drivetrain) -> dict:
                 "count": seat.count,
                 "load_n": seat.load_n, "speed_rpm": seat.speed_rpm,
                 "l10_h": _finite(seat.life_h), "target_h": seat.life_min_h,
-                "passed": seat.life_passed})
+                "passed": seat.life_passed, "load_source": seat.load_source,
+                **({} if seat.peak_load_n is None else {"peak_load_n": seat.peak_load_n})})
     stacks = {name: {"floor_wall_mm": s.floor_wall, "roof_wall_mm": s.roof_wall,
                      "cavity_height_mm": s.cavity_height, "parting_z_mm": s.parting_z,
                      "layers": [list(layer) for layer in s.layers]}

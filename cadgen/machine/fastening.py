@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from kinematics.errors import Problem
 
 from cadgen.machine.bearings import journal_bore, select_bearing
@@ -26,9 +28,15 @@ FLANGE_SHEAR_ALLOW = 190.0
 
 def free_bearing(axis, gear, face, d, machine, report):
     """The bearing a free gear runs on (two side by side in its hub), its life and problems."""
-    load = axis.loads.gears[gear]
+    load = axis.loads.gears[gear].radial_n
     speed = axis.loads.free_speeds.get(gear, 0.0) if hasattr(axis.loads, "free_speeds") else 0.0
-    bearing, life, passed = select_bearing(journal_bore(d), load.radial_n / 2, speed,
+    cycle = axis.loads.cycle
+    if cycle is not None:   # the dynamics': ISO 281's equivalent of its tooth forces
+        from cadgen.machine.cycle_loads import equivalent_load
+
+        load = equivalent_load(np.linalg.norm(cycle.forces[gear], axis=-1),
+                               cycle.free_speed[gear])
+    bearing, life, passed = select_bearing(journal_bore(d), load / 2, speed,
                                            machine.bearing_life_min_h)
     problems = []
     if report and 2 * bearing.width > face + 1e-9:

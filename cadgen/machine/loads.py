@@ -48,6 +48,7 @@ class AxisLoads:
     speed_rpm: float
     external: tuple | None = None
     formulas: dict = field(default_factory=dict)
+    cycle: object = None          # cycle_loads.CycleLoads: the dynamics' loads over the turn
 
 
 def design_load(machine) -> float:

@@ -74,6 +74,8 @@ class BearingSeat:
     life_h: float             # ISO 281 basic rating life L10h; inf when the load is 0
     life_min_h: float
     count: int = 1            # bearings side by side in the seat (2: a pair, face to face)
+    load_source: str = "assumed tip force"   # or the dynamics' (machine.cycle_loads): then
+    peak_load_n: float | None = None         # load_n is ISO 281's P_eq, this the turn's peak
 
     @property
     def life_passed(self) -> bool:
@@ -129,6 +131,8 @@ class Shaft:
     #                            it reaches into another housing; None: from its seats
     flange: dict | None = None  # a hollow shaft's bolted flange carrying a housing
     coupling_key: KeySize | None = None   # the key of its stub (a sprocket or coupling on it)
+    load_source: str = "assumed tip force"   # what its torque, bending and keys' loads are
+    sized_from: str = "assumed tip force"    # what its diameter and bearings were chosen from
 
     @property
     def strength_passed(self) -> bool:

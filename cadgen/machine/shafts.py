@@ -38,7 +38,7 @@ from cadgen.machine.catalogue import CatalogueError, key_for_shaft, key_length, 
 
 __all__ = ["FLAT_DEPTH_RATIO", "KEYLESS_BELOW", "beam_reactions", "bending_moments",
            "max_bending", "required_diameter", "shaft_core", "choose_diameter", "key_pressure",
-           "hub_key", "RULES"]
+           "hub_key", "hollow_required", "RULES"]
 
 #: Shafts below this diameter (mm) get a D-flat instead of a key (no DIN 6885 key under 10 mm
 #: carries a useful torque, and a flat is easier to make on a small shaft).
@@ -173,3 +173,21 @@ def hub_key(d: float, face_width: float):
         return None
     key = key_for_shaft(d, key_length(face_width))
     return key
+
+
+def hollow_required(bending: float, torque: float, bore: float, machine) -> float:
+    """The least outside diameter (mm) of a tube of ``bore`` whose largest shear stress under
+    bending and torsion, ``16 d sqrt(M^2 + T^2) / (pi (d^4 - bore^4))``, stays within ``tau / S``
+    (``tau = yield / 2``), by bisection (the stress falls as ``d`` grows)."""
+    tau = machine.shaft_yield_mpa / 2 / machine.shaft_safety_factor
+    moment = math.hypot(bending, torque)
+
+    def stress(d):
+        return 16 * d * moment / (math.pi * (d ** 4 - bore ** 4))
+    low, high = bore + 1e-6, bore + 200.0
+    if moment == 0.0:
+        return bore
+    for _ in range(100):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if stress(middle) > tau else (low, middle)
+    return high

@@ -239,7 +239,18 @@ def _drivetrain(run):
 
     # the cam (when it was designed) is screwed to gearbox 2 round its contour
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
-    return drivetrain(run.params, run.values["kinematics"], cam)
+    sized = drivetrain(run.params, run.values["kinematics"], cam)
+    if "dynamics" in run.stages:   # sized again from the dynamics' loads (estimated masses)
+        from cadgen.dynamics.sizing import size_from_dynamics
+
+        sized = size_from_dynamics(run.params, run.values["kinematics"], sized, cam=cam,
+                                   events=_events(run))
+    return sized
+
+
+def _events(run):
+    """The soil level and the lowest point (None: a bench run, or no metrics: no soil)."""
+    return run.values["metrics"].events if run.soil and run.status("metrics") == "ok" else None
 
 
 def _teeth(run):
@@ -347,11 +358,14 @@ def _dynamics(run):
         masses, skipped = solid_mass_properties(run.values["parts"])
         source = "solids"
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
-    events = run.values["metrics"].events if run.soil and run.status("metrics") == "ok" \
-        else None
     result = planting_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
-                               cam=cam, events=events, masses=masses, mass_source=source,
+                               cam=cam, events=_events(run), masses=masses, mass_source=source,
                                skipped=skipped)
+    # the drivetrain as built, checked with these loads: what fails is the machine's problem
+    from cadgen.dynamics.sizing import recheck_drivetrain
+
+    run.values["drivetrain"] = recheck_drivetrain(run.params, run.values["kinematics"],
+                                                  run.values["drivetrain"], result)
     train = run.values.get("teeth") if run.status("teeth") == "ok" else None
     if train is not None and train.stages and result.meshes:
         # the teeth under the computed loads: what the report's strength then says

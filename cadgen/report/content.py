@@ -221,6 +221,7 @@ def machine_section(params, drivetrain, train=None) -> dict:
     from cadgen.machine.retention import retention_report
 
     section = drivetrain_report(drivetrain)
+    section["load_sources"] = load_sources(drivetrain)
     section["fits"] = design_fits(params).as_dict()
     section["retention"] = retention_report(getattr(drivetrain, "retention", ()) or ())
     rims = []
@@ -233,6 +234,19 @@ def machine_section(params, drivetrain, train=None) -> dict:
                      "problems": [p.as_dict() for p in rim.problems]})
     section["hubs"] = rims
     return section
+
+
+def load_sources(drivetrain) -> dict:
+    """What the machine's sizes were chosen from and what its reported loads, torques and lives
+    are (``cadgen.machine.cycle_loads``: the assumed tip force, the dynamics with estimated
+    masses, or with the solids' masses), with the re-check's verdict when there was one."""
+    shafts = drivetrain.shafts
+    out = {"sized_from": sorted({s.sized_from for s in shafts}),
+           "checked_with": sorted({s.load_source for s in shafts})}
+    recheck = drivetrain.rules.get("recheck")
+    if recheck is not None:
+        out["recheck_passed"] = recheck["passed"]
+    return out
 
 
 def assembly_section(params, drivetrain, train=None) -> dict:

@@ -81,6 +81,12 @@ def machine_section_html(report: dict) -> str:
             f"keyways +{_e(_number(fits.get('key_slot_allowance_mm'), trim=True))} mm, gear "
             f"backlash allowance {_e(_number(fits.get('backlash_mm'), trim=True))} mm per gear, "
             f"bolt holes ISO 273 {_e(fits.get('bolt_hole_series', '—'))}</p>"]
+    sources = machine.get("load_sources")
+    if sources:   # which load the sizes came from, and which the figures below
+        body.append(f"<p>loads: sizes chosen from the <b>{_e(', '.join(sources['sized_from']))}"
+                    f"</b>; the torques, key pressures, bearing loads and lives below are the "
+                    f"<b>{_e(', '.join(sources['checked_with']))}</b>'s (bearing load: ISO 281's "
+                    f"cycle-equivalent load where the dynamics ran)</p>")
     rows = []
     for s, side in _sides(machine.get("shafts", []), lambda r: r["name"]):
         hubs = "; ".join(
@@ -96,10 +102,10 @@ def machine_section_html(report: dict) -> str:
                      _e(s["housing"]), _e(_number(s["diameter_mm"], trim=True)),
                      _e(_number(s["required_mm"], 1)), _e(_number(s["torque_nm"], 1)),
                      _e(_number(s.get("length_mm"), 1)), _e(hubs or "—"),
-                     _pass_badge(s.get("strength_passed", True))])
+                     _e(s.get("load_source", "—")), _pass_badge(s.get("strength_passed", True))])
     body.append("<h3>Shafts</h3>" + _table(
         ["shaft", "housing", "diameter (mm)", "required (mm)", "torque (N·m)", "length (mm)",
-         "hubs (key, flank pressure)", "strength"], rows, numeric=(2, 3, 4, 5),
+         "hubs (key, flank pressure)", "load from", "strength"], rows, numeric=(2, 3, 4, 5),
         empty="no shafts sized"))
     rows, classes = [], []
     for b, side in _sides(machine.get("bearings", []), lambda r: (r["shaft"], r["wall"])):
@@ -110,11 +116,13 @@ def machine_section_html(report: dict) -> str:
                         f"{_number(b['B_mm'], trim=True)}"),
                      _e(_number(b["C_kn"], trim=True)), _e(_number(b["seat_diameter_mm"], 4)),
                      _e(_number(b["load_n"], 0)), _e(_number(b["speed_rpm"], 1)),
-                     _e(_number(b["l10_h"], significant=3)), _pass_badge(b.get("passed", True))])
+                     _e(_number(b["l10_h"], significant=3)), _e(b.get("load_source", "—")),
+                     _pass_badge(b.get("passed", True))])
         classes.append("" if b.get("passed", True) else "fail")
     body.append("<h3>Bearings (ISO 281 basic rating life L10)</h3>" + _table(
         ["shaft, wall", "bearing", "d x D x B (mm)", "C (kN)", "seat (mm)", "load (N)",
-         "speed (r/min)", "L10 (h)", "life"], rows, numeric=(3, 4, 5, 6, 7), row_classes=classes,
+         "speed (r/min)", "L10 (h)", "load from", "life"], rows, numeric=(3, 4, 5, 6, 7),
+        row_classes=classes,
         empty="no bearings chosen"))
     rims = machine.get("hubs", [])
     if rims:

@@ -228,6 +228,11 @@ def format_machine(machine: dict, bom=None, axial=None) -> str:
     lines = [f"machine ({machine.get('process', MISSING)}): "
              + ", ".join(f"{s['name']} {_number(s['diameter_mm'], 'g')} mm"
                          for s in shafts if s.get("side", 1) == 1)]
+    sources = machine.get("load_sources")
+    if sources:
+        lines.append(f"     loads: sized from the {' and the '.join(sources['sized_from'])}, "
+                     f"checked with the {' and the '.join(sources['checked_with'])}"
+                     + ("" if sources.get("recheck_passed", True) else ": RE-CHECK FAILED"))
     bearings = machine.get("bearings", [])
     if bearings:
         shortest = min(bearings, key=lambda b: b["l10_h"])
