@@ -342,6 +342,11 @@ class _ContactFunctions:
         rho, d_rho, _, psi_rate, _ = self._geometry.gear_curve(v, *self._spec)
         return rho, d_rho, self._angle(v), psi_rate
 
+    def derivatives(self, v):
+        """``(rho, drho, ddrho, dpsi, ddpsi)`` along ``v`` (mm and rad per unit of ``v``), from
+        the ratio law's closed-form derivatives: what the dynamics' accelerations need."""
+        return self._geometry.gear_curve(self._wrapped(v), *self._spec)
+
     def curvature(self, v):
         """Signed curvature (1/mm) of the pitch curve at the contact, convex positive."""
         return parametric_curvature(*self._geometry.gear_curve(self._wrapped(v), *self._spec))

@@ -278,6 +278,12 @@ def _solve(model: Model, inverse, tangential: dict, fixed) -> Solution:
         forces[mesh.name] = np.abs(along[mesh.name]) / np.cos(alpha)
         flank = np.where(along[mesh.name] < 0, -1.0, 1.0)[:, None]
         directions[mesh.name] = flank * np.cos(alpha) * mesh.tangent + np.sin(alpha) * mesh.normal
+        if FRAME in (mesh.driver, mesh.driven):
+            # a gear fixed to the frame (the pricking sun) passes its tooth force on to it
+            on_driven = forces[mesh.name][:, None] * directions[mesh.name]
+            on_frame = -on_driven if mesh.driver == FRAME else on_driven
+            shaking_force += on_frame
+            shaking_moment += _cross(mesh.point, on_frame)
         column += 1
     for couple in model.couples:
         if couple.other == FRAME:

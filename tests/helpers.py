@@ -138,3 +138,51 @@ def stages_before_dynamics(path=REFERENCE):
     run.effects, run.parallel = checked.effects, False
     run.run(pipeline.STAGE_FUNCTIONS)
     return run
+
+
+def exudyn_couple_error(exu, mbs, constraint: int, omega: float, grid, moment):
+    """Solve an Exudyn system (not yet assembled) over one and a half turns at ``omega`` (rad/s)
+    and compare the couple of its rotation ``constraint`` (its multiplier) with ``moment``
+    (N m) given on the angle ``grid`` (rad, one turn): ``(largest difference over the last
+    whole turn, peak of ours)``. The first half turn is left out: the solver starts from
+    inconsistent accelerations, a transient its numerical damping removes."""
+    import math
+
+    import numpy as np
+    from exudyn.utilities import SensorObject
+
+    sensor = mbs.AddSensor(SensorObject(
+        objectNumber=constraint, storeInternal=True,
+        outputVariableType=exu.OutputVariableType.Force))
+    mbs.Assemble()
+    simulation = exu.SimulationSettings()
+    period = 2 * math.pi / omega
+    steps = 1500
+    simulation.timeIntegration.numberOfSteps = steps
+    simulation.timeIntegration.endTime = 1.5 * period
+    simulation.timeIntegration.verboseMode = 0
+    simulation.solutionSettings.sensorsWritePeriod = 1.5 * period / steps
+    # some numerical damping: with none (the trapezoidal rule) an index-3 solver's
+    # multipliers drift; they converge at second order with it
+    simulation.timeIntegration.generalizedAlpha.spectralRadius = 0.6
+    exu.SolveDynamic(mbs, simulation)
+    data = mbs.GetSensorStoredData(sensor)          # [t, lambda]
+    angle = omega * data[:, 0]
+    theirs = data[:, 1]
+    # ours on the exact same angles (periodic interpolation of the grid)
+    ours = np.interp(np.mod(angle, 2 * np.pi), np.append(grid, 2 * np.pi),
+                     np.append(moment, moment[0]))
+    sign = np.sign(np.sum(ours * theirs))       # Exudyn's multiplier sense
+    keep = angle >= np.pi
+    return float(np.max(np.abs(sign * theirs[keep] - ours[keep]))), float(np.max(np.abs(ours)))
+
+
+def exudyn_prescribe(mbs, ground_marker: int, node: int, coordinate: int, law):
+    """Constrain a node's ``coordinate`` to its reference plus ``law(t)`` in an Exudyn system;
+    returns the constraint (its multiplier is the force or couple that drives it)."""
+    from exudyn.utilities import CoordinateConstraint, MarkerNodeCoordinate
+
+    marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=coordinate))
+    return mbs.AddObject(CoordinateConstraint(
+        markerNumbers=[ground_marker, marker],
+        offsetUserFunction=lambda mbs_, t, item, offset: law(t)))

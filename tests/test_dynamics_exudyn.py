@@ -12,7 +12,7 @@ from kinematics.planting import rotating_offset
 
 from cadgen.dynamics import planting_dynamics
 
-from tests.helpers import stages_before_dynamics
+from tests.helpers import exudyn_couple_error, exudyn_prescribe, stages_before_dynamics
 
 exu = pytest.importorskip("exudyn")
 
@@ -48,10 +48,9 @@ def stages():
 
 def test_exudyn_turns_the_planter_with_the_couple_our_mesh_force_gives(stages, tmp_path,
                                                                        monkeypatch):
-    from exudyn.utilities import (CoordinateConstraint, LoadMassProportional, MarkerBodyMass,
+    from exudyn.utilities import (LoadMassProportional, MarkerBodyMass,
                                   MarkerBodyPosition, MarkerNodeCoordinate, NodePointGround,
-                                  NodeRigidBody2D, ObjectJointRevolute2D, ObjectRigidBody2D,
-                                  SensorObject)
+                                  NodeRigidBody2D, ObjectJointRevolute2D, ObjectRigidBody2D)
 
     monkeypatch.chdir(tmp_path)     # Exudyn writes its solution folder where it runs
     result, moment = _ours(stages)
@@ -94,11 +93,7 @@ def test_exudyn_turns_the_planter_with_the_couple_our_mesh_force_gives(stages, t
     ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
 
     def prescribe(node_number, coordinate, law):
-        marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node_number,
-                                                    coordinate=coordinate))
-        return mbs.AddObject(CoordinateConstraint(
-            markerNumbers=[ground_marker, marker],
-            offsetUserFunction=lambda mbs_, t, item, offset: law(t)))
+        return exudyn_prescribe(mbs, ground_marker, node_number, coordinate, law)
 
     prescribe(box_node, 0, lambda t: box_pose(t)[0][0] - box_start[0])
     prescribe(box_node, 1, lambda t: box_pose(t)[0][1] - box_start[1])
@@ -112,29 +107,5 @@ def test_exudyn_turns_the_planter_with_the_couple_our_mesh_force_gives(stages, t
     for number in (box_body, body):
         mbs.AddLoad(LoadMassProportional(markerNumber=mbs.AddMarker(
             MarkerBodyMass(bodyNumber=number)), loadVector=[0, -9.80665, 0]))
-    sensor = mbs.AddSensor(SensorObject(objectNumber=turn, storeInternal=True,
-                                        outputVariableType=exu.OutputVariableType.Force))
-    mbs.Assemble()
-    simulation = exu.SimulationSettings()
-    period = 2 * math.pi / omega
-    steps = 1500        # one and a half turns: the start's transient has died by half a turn
-    simulation.timeIntegration.numberOfSteps = steps
-    simulation.timeIntegration.endTime = 1.5 * period
-    simulation.timeIntegration.verboseMode = 0
-    simulation.solutionSettings.sensorsWritePeriod = 1.5 * period / steps
-    # some numerical damping: with none (the trapezoidal rule) an index-3 solver's
-    # multipliers drift; they converge at second order with it
-    simulation.timeIntegration.generalizedAlpha.spectralRadius = 0.6
-    exu.SolveDynamic(mbs, simulation)
-    data = mbs.GetSensorStoredData(sensor)          # [t, lambda]
-    phi = omega * data[:, 0]
-    theirs = data[:, 1]
-    # ours on the exact same angles (periodic interpolation of the grid)
-    ours = np.interp(np.mod(phi, 2 * np.pi), np.append(result.phi, 2 * np.pi),
-                     np.append(moment, moment[0]))
-    peak = np.max(np.abs(ours))
-    sign = np.sign(np.sum(ours * theirs))       # Exudyn's multiplier sense
-    # a whole turn, after the first half turn: the solver starts from inconsistent
-    # accelerations, a transient its numerical damping removes
-    keep = phi >= np.pi
-    assert np.max(np.abs(sign * theirs[keep] - ours[keep])) <= 1e-3 * peak
+    error, peak = exudyn_couple_error(exu, mbs, turn, omega, result.phi, moment)
+    assert error <= 1e-3 * peak, f"{error / peak:.2e} of the peak {peak:.4g} N m"

@@ -195,7 +195,7 @@ def test_kernel_b_loads_with_the_spec_values():
 def test_the_two_examples_differ_only_in_name_points_degree_and_speed():
     a, b = load_params(KERNEL_A), load_params(KERNEL_B)
     same = {"mechanism", "linkage", "gears", "field", "resolution", "housing", "ground", "solids",
-            "machine", "manufacturing", "scene"}
+            "machine", "manufacturing", "dynamics", "scene"}
     # forward speeds differ: each is set so its tip is nearly still over the ground at the bottom
     assert (a.field.forward_speed, b.field.forward_speed) == (530.0, 600.0)
     b = b.model_copy(update={"field": b.field.model_copy(update={"forward_speed": 530.0})})

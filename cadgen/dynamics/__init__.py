@@ -1,6 +1,8 @@
-"""Dynamics of the planting mechanism over one carrier turn: drive torque, joint and mesh forces.
+"""Dynamics of a mechanism over one carrier turn: drive torque, joint and mesh forces.
 
-The ``dynamics`` effect (a build stage of the same name) runs :func:`planting_dynamics`:
+The ``dynamics`` effect (a build stage of the same name) runs :func:`planting_dynamics`
+(the pricking mechanism: :func:`pricking_dynamics`, :mod:`cadgen.dynamics.pricking`, the same
+result and report):
 every moving body's mass, centre of mass and inertia (from the solids when they were built,
 else estimated from the parameters: :mod:`cadgen.dynamics.mass`), the known loads of
 ``[dynamics]`` (:mod:`cadgen.dynamics.loads`), and an inverse-dynamics solve on a uniform grid
@@ -27,7 +29,12 @@ value, ``run.values["dynamics"]``) is a :class:`DynamicsResult`:
     frame; its sign says which flank carries);
   - ``pitch_parameter`` (n,) rad for the non-circular pair: ``t`` of the central gear's pitch
     curve ``r1(t)`` at the contact (the intermediate's radius there is ``a - r1(t)``), None
-    for a circular pair.
+    for a circular pair. The pricking mechanism's two meshes are keyed ``("sun",
+    "intermediate 1", 0)`` and ``("intermediate 2", "planet", 0)``, and their
+    ``pitch_parameter`` is the pair's cycle parameter ``tau``
+    (:class:`~cadgen.gears.pairs.PitchPair`'s, the curve parameter from the outer dead
+    centre): ``train_strength(..., mesh_forces={(driver, driven): (m.pitch_parameter,
+    m.normal_force_n)})``.
 
   So the bending and contact stresses at each pose follow from ``normal_force_n`` and the
   local pitch radius and curvature at ``pitch_parameter`` (or ``contact_radius``).
@@ -40,6 +47,7 @@ value, ``run.values["dynamics"]``) is a :class:`DynamicsResult`:
 
 from cadgen.dynamics.analysis import (DynamicsResult, MeshLoad, dynamics_report,
                                       motor_and_flywheel, planting_dynamics)
+from cadgen.dynamics.pricking_analysis import pricking_dynamics
 
 __all__ = ["DynamicsResult", "MeshLoad", "dynamics_report", "motor_and_flywheel",
-           "planting_dynamics"]
+           "planting_dynamics", "pricking_dynamics"]

@@ -69,6 +69,7 @@ class DynamicsResult:
     invalid: list = field(default_factory=list)  # what falls outside the model's validity
     #: the gears' tooth strength under these loads (machine.gear_strength), when cut
     strength: object = None
+    extra: dict = field(default_factory=dict)    # a mechanism's own report keys (pricking)
 
     def stats(self, values) -> dict:
         values = np.asarray(values, dtype=float)
@@ -323,6 +324,7 @@ def _section(result: DynamicsResult, params) -> dict:
         "notes": list(result.notes), "outside_validity": list(result.invalid),
         "passed": result.energy_balance_max_rel <= ENERGY_BALANCE_RTOL and not result.invalid,
     }
+    out.update(result.extra)
     if result.cam is not None:
         force, _, _, spring = result.cam.arm(0)
         out["cam_contact_force_n"] = _round(force, 5)

@@ -92,15 +92,18 @@ def _combine(items) -> BodyMass:
                     tuple(name for _, _, _, name in items))
 
 
-def solid_mass_properties(outcome) -> tuple:
+def solid_mass_properties(outcome, body_of=body_of_part) -> tuple:
     """``({body: BodyMass}, skipped)`` of the built solids at carrier angle 0.
 
     Each made part's mass properties are integrated once in its own frame and moved to every
     copy's pose (the centre by the pose, the inertia tensor turned: ``R I R^T``); the bought
     solids ride with their host part's body. ``skipped``: ``[(part, reason)]`` of meshes that
-    could not be integrated (never silently: the report lists them).
+    could not be integrated (never silently: the report lists them). ``body_of(part name,
+    second side)``: the part's body (the pricking mechanism's:
+    :func:`cadgen.dynamics.pricking_mass.pricking_body_of_part`).
     """
     from cadgen.machine.fits import FitError, process_fits
+    from cadgen.solids.bought import BoughtPart
     from cadgen.solids.errors import SolidError
     from cadgen.solids.mass import mass_properties
 
@@ -113,14 +116,15 @@ def solid_mass_properties(outcome) -> tuple:
         host = getattr(part, "host", "")
         for name, body_name, phase in part.instances or ((part.name, part.body, 0.0),):
             second = body_name.endswith(":mirrored") or abs(phase - math.pi) < 1e-9
-            body = body_of_part(host or part.name, second)
+            body = body_of(host or part.name, second)
             if body is None:
                 continue
             # a bought item's mesh is one per catalogue size, shared by every item of that size
             key = ("bought", id(part.mesh)) if host else part.name
             if key not in own:
                 try:
-                    density = STEEL_DENSITY if host else (
+                    # a bought solid (hosted, or placed alone as the pricking sprocket)
+                    density = STEEL_DENSITY if host or isinstance(part, BoughtPart) else (
                         outcome.density or fits.material(part.kind).density)
                     own[key] = mass_properties(part.mesh, density)
                 except (SolidError, FitError) as error:

@@ -19,6 +19,9 @@ Every default is stated with its source or reasoning (docs/dynamics.md repeats t
 * motor margins: rated torque at least 1.25 x the RMS (thermal reserve) and the peak at most
   1.6 x rated (IEC 60034-1's momentary excess torque of an induction motor).
 
+The pricking mechanism reads the same table: its soil reaction acts on the needle's tip
+(``soil_force_n`` at the vertical pricking depth), its seedling and plant spacing are unused.
+
 ``load_case = "none"`` leaves out every external load and loss (seedling, soil, the cam's
 spring, friction); gravity stays. Over a carrier turn the mean input torque is then zero,
 and the torque less its gravity part scales with the speed squared.
@@ -43,15 +46,18 @@ class DynamicsParameters(_Table):
     """Loads, friction, the speed sweep and the motor and flywheel rules of the dynamics."""
 
     load_case: Literal["planting", "none"] = Field(
-        "planting", description='"planting": seedling, soil, cam spring, friction; "none": '
-                                'gravity only')
-    seedling_mass_kg: float = Field(0.03, ge=0, le=10, description="pot seedling mass, kg")
+        "planting", description='"planting": the working loads (planting mechanism: seedling, '
+                                'soil, cam spring; pricking: soil on the needle) and friction; '
+                                '"none": gravity only')
+    seedling_mass_kg: float = Field(0.03, ge=0, le=10,
+                                    description="pot seedling mass, kg (planting mechanism)")
     soil_force_n: float = Field(50.0, ge=0, le=1e5,
-                                description="soil resistance on the duckbill at the planting "
-                                            "depth, N (in proportion to depth)")
+                                description="soil resistance on the duckbill (the pricking "
+                                            "needle) at the depth, N (in proportion to depth)")
     plant_spacing: float | None = Field(
         None, gt=0, description="plant spacing for the tip's velocity over the ground, mm "
-                                "(default: the first of field.plant_spacings)")
+                                "(default: the first of field.plant_spacings; planting "
+                                "mechanism: the pricking one's is field.forward_speed)")
     bearing_friction: float = Field(0.0015, ge=0, le=0.5,
                                     description="bearing friction coefficient, M = mu F d / 2")
     mesh_friction: float = Field(0.05, ge=0, le=0.5,

@@ -18,6 +18,7 @@ from pydantic_core import PydanticCustomError
 
 from cadgen.params._problems import _close_keys, _describe, _problems_error, _show
 from cadgen.params.cutting import CuttingParameters, PrickingShifts
+from cadgen.params.dynamics import DynamicsParameters
 from cadgen.params.scene import SceneParameters
 from cadgen.params.solids import GroundParameters, ShellParameters, SolidsParameters
 from cadgen.params.machine import ManufacturingParameters, PrickingMachineParameters
@@ -265,5 +266,6 @@ class PrickingParameters(_Table):
     solids: SolidsParameters = SolidsParameters()
     machine: PrickingMachineParameters = PrickingMachineParameters()
     manufacturing: ManufacturingParameters = ManufacturingParameters()
+    dynamics: DynamicsParameters = DynamicsParameters()
     scene: SceneParameters = SceneParameters()
 

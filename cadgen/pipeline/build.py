@@ -22,7 +22,7 @@ parts               the solids: split housings (base and cover with bearing
                     checks
 arm_interference    FCL sweep of arm against arm (planting)
 ground_clearance    FCL sweep of every housing against the ground
-dynamics            inverse dynamics over a carrier turn (planting): drive torque,
+dynamics            inverse dynamics over a carrier turn: drive torque,
                     bearing and mesh forces, shaking force (:mod:`cadgen.dynamics`)
 plots               PNG pictures of what ran
 ==================  ==========================================================
@@ -343,20 +343,33 @@ def _ground_clearance(run):
 
 
 def _dynamics(run):
-    """Inverse dynamics over a carrier turn (planting): masses from the solids when the parts
-    and the gears were built, else estimated from the parameters."""
+    """Inverse dynamics over a carrier turn: masses from the solids when the parts and the
+    gears were built, else estimated from the parameters."""
     from cadgen.dynamics import planting_dynamics
 
+    pricking = run.params.mechanism == "pricking"
     masses, source, skipped = None, "estimated", ()
-    if run.status("parts") == "ok" and run.status("teeth") == "ok":
+    # a pricking stage that could not be cut leaves its gears out of the solids: estimate
+    cut = run.status("teeth") == "ok" and not (pricking and run.values["teeth"].failures)
+    if run.status("parts") == "ok" and cut:
         from cadgen.dynamics.mass import solid_mass_properties
 
         if run._beside is not None:     # the worker's meshes of the gearless parts, not again
             from cadgen.pipeline.beside import take_meshes
 
             take_meshes(run, run._beside)
-        masses, skipped = solid_mass_properties(run.values["parts"])
+        from cadgen.dynamics.pricking_mass import pricking_body_of_part
+
+        masses, skipped = solid_mass_properties(
+            run.values["parts"], **({"body_of": pricking_body_of_part} if pricking else {}))
         source = "solids"
+    if pricking:
+        from cadgen.dynamics import pricking_dynamics
+
+        field = run.values["metrics"] if run.soil and run.status("metrics") == "ok" else None
+        return pricking_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
+                                 field=field, masses=masses, mass_source=source,
+                                 skipped=skipped)
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
     result = planting_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
                                cam=cam, events=_events(run), masses=masses, mass_source=source,

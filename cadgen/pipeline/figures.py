@@ -50,7 +50,8 @@ def figure_jobs(run) -> dict:
         from cadgen.dynamics import dynamics_report
         from cadgen.report.plots.dynamics import dynamics_figure_jobs
 
-        events = values["metrics"].events if run.soil and "metrics" in ok else None
+        events = values["metrics"].events if (run.soil and "metrics" in ok
+                                              and params.mechanism != "pricking") else None
         jobs.update(dynamics_figure_jobs(dynamics_report(values["dynamics"], params), events))
     sweeps = {key: values[key] for key in ("arm_interference", "ground_clearance") if key in ok}
     if sweeps:

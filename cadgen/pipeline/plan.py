@@ -60,8 +60,6 @@ STAGE_ORDER = tuple(STAGE_NEEDS)
 NOT_APPLICABLE = {
     ("pricking", "cam"): "the pricking mechanism has no cam",
     ("pricking", "arm_interference"): "the pricking mechanism has a single arm",
-    ("pricking", "dynamics"): "dynamics is not modelled for the pricking mechanism (only the "
-                              "planting mechanism's drive torque and forces are computed)",
     ("bench", "ground_clearance"): "a bench run has no soil",
 }
 

@@ -15,8 +15,19 @@ __all__ = ["dynamics_figure_jobs", "torque_and_power", "mesh_forces", "bearing_l
            "shaking_polar"]
 
 
-def _events(events) -> dict:
-    """``{label: carrier angle deg}`` of both arms' events (arm 2 half a turn later)."""
+#: The planting mechanism's carrier-angle axis (a section may name its own).
+PLANTING_ANGLE_LABEL = "carrier angle (deg, 0 = arm 1 catching)"
+
+
+def _label(section: dict) -> str:
+    return section.get("carrier_angle_label", PLANTING_ANGLE_LABEL)
+
+
+def _events(events, section: dict | None = None) -> dict:
+    """``{label: carrier angle deg}`` of both arms' events (arm 2 half a turn later), or the
+    section's own ``events_deg`` (the pricking mechanism's dead centre, soil entry and exit)."""
+    if section is not None and "events_deg" in section:
+        return dict(section["events_deg"])
     if events is None:
         return {"catch 1": 0.0, "catch 2": 180.0}
     out = {}
@@ -41,7 +52,7 @@ def torque_and_power(section: dict, events) -> bytes:
     power = np.asarray(section["input_power_w"])
     stats = section["summary"]
     figure, (top, bottom) = _figure(8.0, 6.5, nrows=2, sharex=True)
-    marks = _events(events)
+    marks = _events(events, section)
     top.plot(angle, torque, color="tab:blue", label="input torque (N m)")
     for value, style, name in ((stats["input_torque_nm"]["rms"], ":", "RMS"),
                                (stats["input_torque_nm"]["mean"], "--", "mean")):
@@ -51,7 +62,7 @@ def torque_and_power(section: dict, events) -> bytes:
                    label=f"mean {stats['input_power_w']['mean']:.3g} W")
     top.set_ylabel("input torque (N m)")
     bottom.set_ylabel("input power (W)")
-    bottom.set_xlabel("carrier angle (deg, 0 = arm 1 catching)")
+    bottom.set_xlabel(_label(section))
     _mark(top, marks, True)
     _mark(bottom, marks, False)
     for axes in (top, bottom):
@@ -84,10 +95,10 @@ def mesh_forces(section: dict, events) -> bytes:
               if "(arm 2)" not in name}
     figure, axes = _figure(8.0, 5.5)
     _curves(axes, angle, forces, "normal force along the line of action (N)")
-    _mark(axes, _events(events), True)
-    axes.set_xlabel("carrier angle (deg, 0 = arm 1 catching)")
+    _mark(axes, _events(events, section), True)
+    axes.set_xlabel(_label(section))
     axes.set_title("Gear mesh forces (arm 1's train and the drive; arm 2's are half a turn "
-                   "later)", fontsize=9)
+                   "later)" if "bodies" not in section else "Gear mesh forces", fontsize=9)
     _legend_below(figure, *axes.get_legend_handles_labels(), ncols=3, fontsize=6)
     return _png(figure)
 
@@ -99,10 +110,10 @@ def bearing_loads(section: dict, events) -> bytes:
               if not name.endswith(" 2")}
     figure, axes = _figure(8.0, 5.5)
     _curves(axes, angle, forces, "bearing force, planar resultant (N)")
-    _mark(axes, _events(events), True)
-    axes.set_xlabel("carrier angle (deg, 0 = arm 1 catching)")
-    axes.set_title("Bearing loads: each shaft's two bearings together (arm 1 and the machine)",
-                   fontsize=9)
+    _mark(axes, _events(events, section), True)
+    axes.set_xlabel(_label(section))
+    axes.set_title("Bearing loads: each shaft's two bearings together"
+                   + (" (arm 1 and the machine)" if "bodies" not in section else ""), fontsize=9)
     _legend_below(figure, *axes.get_legend_handles_labels(), ncols=3, fontsize=7)
     return _png(figure)
 
