@@ -240,7 +240,9 @@ def _drivetrain(run):
     # the cam (when it was designed) is screwed to gearbox 2 round its contour
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
     sized = drivetrain(run.params, run.values["kinematics"], cam)
-    if "dynamics" in run.stages:   # sized again from the dynamics' loads (estimated masses)
+    # sized again from the dynamics' loads (estimated masses); the pricking drivetrain keeps
+    # the assumed tip force (its dynamics reports the loads beside it)
+    if "dynamics" in run.stages and run.params.mechanism == "planting":
         from cadgen.dynamics.sizing import size_from_dynamics
 
         sized = size_from_dynamics(run.params, run.values["kinematics"], sized, cam=cam,
@@ -367,18 +369,19 @@ def _dynamics(run):
         from cadgen.dynamics import pricking_dynamics
 
         field = run.values["metrics"] if run.soil and run.status("metrics") == "ok" else None
-        return pricking_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
-                                 field=field, masses=masses, mass_source=source,
-                                 skipped=skipped)
-    cam = run.values.get("cam") if run.status("cam") == "ok" else None
-    result = planting_dynamics(run.params, run.values["kinematics"], run.values["drivetrain"],
-                               cam=cam, events=_events(run), masses=masses, mass_source=source,
-                               skipped=skipped)
-    # the drivetrain as built, checked with these loads: what fails is the machine's problem
-    from cadgen.dynamics.sizing import recheck_drivetrain
+        result = pricking_dynamics(run.params, run.values["kinematics"],
+                                   run.values["drivetrain"], field=field, masses=masses,
+                                   mass_source=source, skipped=skipped)
+    else:
+        cam = run.values.get("cam") if run.status("cam") == "ok" else None
+        result = planting_dynamics(run.params, run.values["kinematics"],
+                                   run.values["drivetrain"], cam=cam, events=_events(run),
+                                   masses=masses, mass_source=source, skipped=skipped)
+        # the drivetrain as built, checked with these loads: what fails is the machine's
+        from cadgen.dynamics.sizing import recheck_drivetrain
 
-    run.values["drivetrain"] = recheck_drivetrain(run.params, run.values["kinematics"],
-                                                  run.values["drivetrain"], result)
+        run.values["drivetrain"] = recheck_drivetrain(run.params, run.values["kinematics"],
+                                                      run.values["drivetrain"], result)
     train = run.values.get("teeth") if run.status("teeth") == "ok" else None
     if train is not None and train.stages and result.meshes:
         # the teeth under the computed loads: what the report's strength then says
