@@ -156,29 +156,29 @@ def test_a_heavier_dynamic_load_than_the_static_sizing_fails_the_recheck(paper):
     assert SOLID_MASSES != ESTIMATED_MASSES
 
 
-def test_without_dynamics_the_machine_is_sized_from_the_tip_force_alone():
-    """With effects lacking dynamics, every shaft and bearing says the assumed tip force, and
-    the machine is the drivetrain sized from it alone (no cycle loads): the same diameters,
-    bearings and torques as :func:`drivetrain` without ``cycles``. Paper design, by hand
-    (docs/machine.md): T_E = F (L1 ...) is the static sizing's, checked in test_machine."""
-    from cadgen.cam.design import design_cam
-    from cadgen.design import build_mechanism, evaluate
+def test_the_machine_is_the_same_whatever_the_scene_and_the_pricking_one_the_static():
+    """A design is the same parts whatever the build is asked: the planting drivetrain is sized
+    from its estimated-mass dynamics in a scene without the dynamics effect too (the gear
+    files' bores are the full build's), and the pricking drivetrain from the tip force, as
+    :func:`drivetrain` sizes it alone."""
+    from cadgen.design import pricking_design
     from cadgen.machine.drivetrain import drivetrain, drivetrain_report
     from cadgen.params import load_params
     from cadgen.pipeline.build import build
 
     params = load_params(PAPER)
-    report = build(params, None, effects=["metrics", "cam", "teeth"]).report
-    machine = report["machine"]
-    assert machine["load_sources"] == {"sized_from": ["assumed tip force"],
-                                       "checked_with": ["assumed tip force"]}
+    shafts = {}
+    for effects in (["metrics", "cam", "teeth"], ["dynamics"]):
+        machine = build(params, None, effects=effects).report["machine"]
+        assert machine["load_sources"]["sized_from"] == [ESTIMATED_MASSES], effects
+        shafts[tuple(effects)] = [(s["name"], s["side"], s["diameter_mm"])
+                                  for s in machine["shafts"]]
+    assert len(set(map(tuple, shafts.values()))) == 1
+    pricking = load_params(REPO / "params" / "kernel-b.toml")
+    machine = build(pricking, None, effects=["metrics", "teeth"]).report["machine"]
+    assert machine["load_sources"]["sized_from"] == ["assumed tip force"]
     for record in machine["shafts"] + machine["bearings"]:
         assert record["load_source"] == "assumed tip force"
-        assert "peak_load_n" not in record
-    mechanism = build_mechanism(params)
-    cam = design_cam(params, mechanism, evaluate(params, mechanism, steps=720).events)
-    static = drivetrain_report(drivetrain(params, mechanism, cam))
-    assert [(s["name"], s["side"], s["diameter_mm"]) for s in machine["shafts"]] == [
-        (s["name"], s["side"], s["diameter_mm"]) for s in static["shafts"]]
-    assert [b["designation"] for b in machine["bearings"]] == [
-        b["designation"] for b in static["bearings"]]
+    static = drivetrain_report(drivetrain(pricking, pricking_design(pricking)))
+    assert [(s["name"], s["diameter_mm"]) for s in machine["shafts"]] == [
+        (s["name"], s["diameter_mm"]) for s in static["shafts"]]

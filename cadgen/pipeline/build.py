@@ -240,13 +240,15 @@ def _drivetrain(run):
     # the cam (when it was designed) is screwed to gearbox 2 round its contour
     cam = run.values.get("cam") if run.status("cam") == "ok" else None
     sized = drivetrain(run.params, run.values["kinematics"], cam)
-    # sized again from the dynamics' loads (estimated masses); the pricking drivetrain keeps
+    # sized again from the dynamics' loads (estimated masses), in every scene that designs it
+    # and whatever the case (the machine is made for the field: the soil's load is in), so a
+    # design is the same parts whatever is asked of the build; the pricking drivetrain keeps
     # the assumed tip force (its dynamics reports the loads beside it)
-    if "dynamics" in run.stages and run.params.mechanism == "planting":
+    if run.params.mechanism == "planting" and run.status("metrics") == "ok":
         from cadgen.dynamics.sizing import size_from_dynamics
 
         sized = size_from_dynamics(run.params, run.values["kinematics"], sized, cam=cam,
-                                   events=_events(run))
+                                   events=run.values["metrics"].events)
     return sized
 
 

@@ -46,7 +46,9 @@ STAGE_NEEDS = {
     "kinematics": (),
     "metrics": ("kinematics",),
     "cam": ("metrics",),
-    "drivetrain": ("kinematics",),
+    # the planting drivetrain is sized from its dynamics, which read the soil (metrics) and the
+    # cam's spring: every scene that designs it designs the same one
+    "drivetrain": ("kinematics", "metrics", "cam"),
     "teeth": ("kinematics",),
     "parts": ("metrics", "drivetrain"),
     "arm_interference": ("parts",),
@@ -91,6 +93,8 @@ def plan(effects, mechanism: str = "planting", case: str = "field"):
         if stage not in closed:
             closed.add(stage)
             stack.extend(STAGE_NEEDS[stage])
+    if mechanism == "pricking":   # the drivetrain's need of a cam is the planting one's
+        closed.discard("cam")
     return [s for s in STAGE_ORDER if s in closed], set_aside
 
 
