@@ -182,3 +182,20 @@ def test_the_machine_is_the_same_whatever_the_scene_and_the_pricking_one_the_sta
     static = drivetrain_report(drivetrain(pricking, pricking_design(pricking)))
     assert [(s["name"], s["diameter_mm"]) for s in machine["shafts"]] == [
         (s["name"], s["diameter_mm"]) for s in static["shafts"]]
+
+
+def test_load_case_none_checks_the_model_and_still_sizes_the_machine_for_the_field():
+    """``load_case = "none"`` leaves the soil and the seedling out of the report's dynamics,
+    not out of the machine: the shafts are those of the default load case."""
+    from cadgen.params import load_params, validate_text
+    from cadgen.pipeline.build import build
+
+    from helpers import with_keys
+
+    text = PAPER.read_text(encoding="utf-8")
+    none = validate_text(with_keys(text, "dynamics", load_case='"none"'))
+    sizes = []
+    for params in (load_params(PAPER), none):
+        machine = build(params, None, effects=["metrics", "cam", "teeth"]).report["machine"]
+        sizes.append([(s["name"], s["side"], s["diameter_mm"]) for s in machine["shafts"]])
+    assert sizes[0] == sizes[1]

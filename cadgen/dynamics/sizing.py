@@ -122,9 +122,11 @@ def axis_cycles(params, mechanism, drivetrain, result, source: str) -> dict:
 
 def _sizing_params(params):
     """The parameters the sizing's dynamics run with: the file's speed alone (the speed sweep
-    is the report's, not the sizing's)."""
+    is the report's, not the sizing's) and the field's loads whatever ``load_case`` the report
+    asks (``"none"`` is a check of the model: a machine sized without its soil would break in
+    it)."""
     settings = params.dynamics.model_copy(update={
-        "speeds_rpm": (float(params.field.carrier_speed_rpm),)})
+        "speeds_rpm": (float(params.field.carrier_speed_rpm),), "load_case": "planting"})
     return params.model_copy(update={"dynamics": settings})
 
 

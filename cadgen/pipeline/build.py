@@ -379,11 +379,13 @@ def _dynamics(run):
         result = planting_dynamics(run.params, run.values["kinematics"],
                                    run.values["drivetrain"], cam=cam, events=_events(run),
                                    masses=masses, mass_source=source, skipped=skipped)
-        # the drivetrain as built, checked with these loads: what fails is the machine's
-        from cadgen.dynamics.sizing import recheck_drivetrain
+        # the drivetrain as built, checked with these loads: what fails is the machine's (the
+        # field's loads only: load case "none" checks the model, not the machine)
+        if result.load_case == "planting":
+            from cadgen.dynamics.sizing import recheck_drivetrain
 
-        run.values["drivetrain"] = recheck_drivetrain(run.params, run.values["kinematics"],
-                                                      run.values["drivetrain"], result)
+            run.values["drivetrain"] = recheck_drivetrain(
+                run.params, run.values["kinematics"], run.values["drivetrain"], result)
     train = run.values.get("teeth") if run.status("teeth") == "ok" else None
     if train is not None and train.stages and result.meshes:
         # the teeth under the computed loads: what the report's strength then says
