@@ -51,7 +51,7 @@ def test_writes_report_and_plots(params, tmp_path):
                              # shaft inside a cavity (2 mm gaps; one long one under E's gear;
                              # S and C hold only their gear and bearing pair)
                              *(f"spacer-{axis}-{k}.stl" for axis, count in (
-                                 ("O", 3), ("S", 1), ("input", 2), ("A", 3), ("B", 3),
+                                 ("O", 3), ("S", 1), ("input", 3), ("A", 3), ("B", 3),
                                  ("C2", 2), ("C", 1), ("D", 3), ("E", 2))
                                for k in range(1, count + 1))])
     report = json.loads((folder / "report.json").read_text())

@@ -310,8 +310,8 @@ def test_each_ring_sits_in_its_groove_on_its_shafts_axis(planting):
     shaft's least radius over the ring's height is d2 / 2 of the standard's table (d 15: d2
     14.3, s 1; d 20: 19, 1.2), and the ring is s thick; every shaft with a ring in its stack
     has it as a solid."""
-    table = {15.0: (14.3, 1.0), 17.0: (16.2, 1.0), 20.0: (19.0, 1.2), 25.0: (23.9, 1.2),
-             30.0: (28.6, 1.5)}   # DIN 471: d1 -> (d2, s)
+    table = {12.0: (11.5, 1.0), 15.0: (14.3, 1.0), 17.0: (16.2, 1.0), 20.0: (19.0, 1.2),
+             25.0: (23.9, 1.2), 30.0: (28.6, 1.5)}   # DIN 471: d1 -> (d2, s)
     assembly = planting[1]["parts"].assembly
     parts = {part.name: part for part in assembly.parts}
     rings = [part for part in assembly.bought if part.kind == "retaining ring"

@@ -67,8 +67,11 @@ def test_cached_builds_write_the_bytes_an_uncached_build_writes(paper, uncached,
     # drawing), and each gear's cutting outline
     dxf = [name for name in uncached if name.startswith("gears/")]
     assert "drawings/train.dxf" in uncached
+    # and the cam's cutting file and drawing (the drivetrain the gears are bored for is sized
+    # with the cam's spring, so these scenes design the cam too)
+    assert "drawings/cam.dxf" in uncached   # and cam.dxf beside the folders
     assert len(_stage_entries(cache)) == PAIRS
-    assert GearCache(cache).stats()[0] == PAIRS + (len(dxf) + 1) + len(dxf)
+    assert GearCache(cache).stats()[0] == PAIRS + (len(dxf) + 1) + len(dxf) + 2
 
 
 def _stage_entries(cache: Path) -> list:
@@ -181,7 +184,8 @@ def test_a_damaged_file_entry_is_made_again(paper, uncached, tmp_path):
     store = GearCache(cache)
     files = [entry for entry in sorted(cache.glob("??/*.gear"))
              if isinstance(store.get(entry.stem), bytes)]
-    assert len(files) == sum(name.startswith("gears/") for name in uncached) + 1   # the sheet
+    # the gears' files, the sheet and the cam's two (its file and drawing)
+    assert len(files) == sum(name.startswith("gears/") for name in uncached) + 1 + 2
     for victim in files[:3]:
         data = victim.read_bytes()
         victim.write_bytes(data[:-1] + bytes([data[-1] ^ 0x01]))   # a payload byte flipped

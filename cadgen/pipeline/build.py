@@ -237,13 +237,10 @@ def _metrics(run):
 def _drivetrain(run):
     from cadgen.machine.drivetrain import drivetrain
 
-    # the cam (when it was designed) is screwed to gearbox 2 round its contour
-    cam = run.values.get("cam") if run.status("cam") == "ok" else None
+    cam = run.values.get("cam") if run.status("cam") == "ok" else None   # screwed to gearbox 2
     sized = drivetrain(run.params, run.values["kinematics"], cam)
-    # sized again from the dynamics' loads (estimated masses), in every scene that designs it
-    # and whatever the case (the machine is made for the field: the soil's load is in), so a
-    # design is the same parts whatever is asked of the build; the pricking drivetrain keeps
-    # the assumed tip force (its dynamics reports the loads beside it)
+    # sized again from the dynamics' loads (estimated masses, the field's) in every scene and
+    # case: a design is the same parts whatever the build is asked (pricking: the tip force)
     if run.params.mechanism == "planting" and run.status("metrics") == "ok":
         from cadgen.dynamics.sizing import size_from_dynamics
 
