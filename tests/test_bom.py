@@ -67,8 +67,6 @@ _NODE_STEMS = (
 
 def _placed_solids(scene, row) -> int:
     """The assembly file's nodes placing the bought item of a bill row as a solid."""
-    import re
-
     names = list(scene.graph.nodes_geometry)
     if row["part"] == "sprocket":    # bought whole, placed as its envelope under the case
         return sum(1 for n in names if n == "case-sprocket")

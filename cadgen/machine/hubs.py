@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -349,7 +348,9 @@ def set_screw_clearance(profile, shaft, key, designation: str) -> float:
     the screw stands proud). The screw is radial on the keyway's centre line, its point on
     the key's back (``d/2 - t1 + h`` from the axis), as long as its designation says
     (``... M5 x 8 ...``)."""
-    length = float(re.search(r"M\d+ x (\d+(?:\.\d+)?)", designation).group(1))
+    from cadgen.machine.retention import set_screw_size
+
+    _, length = set_screw_size(designation)
     back = shaft.diameter / 2 - key.shaft_depth + key.height
     angle = float(profile.notes.get("keyway_angle_rad", 0.0))
     outline = np.asarray(profile.outline, dtype=float) - np.asarray(profile.centre, dtype=float)

@@ -30,6 +30,8 @@ the whole machine's contacts (shafts, housings, flanges) and names any part free
 
 from __future__ import annotations
 
+import re
+
 import math
 from dataclasses import dataclass, field
 
@@ -37,7 +39,7 @@ from cadgen.machine.catalogue import CatalogueError, shaft_ring
 from kinematics.errors import Problem
 
 __all__ = ["AXIAL_PLAY", "MIN_SPACER", "RING_CLEARANCE", "SPACER_BORE_CLEARANCE", "MAX_PLAY", "StackPart",
-           "ShaftRetention", "ring_room", "drivetrain_retention", "spacer_outside", "set_screw", "shaft_retention",
+           "ShaftRetention", "set_screw_size", "ring_room", "drivetrain_retention", "spacer_outside", "set_screw", "shaft_retention",
            "retention_report"]
 
 #: Axial play (mm) left in a stack held between two shoulders: the bearings are not preloaded
@@ -77,6 +79,14 @@ def set_screw(key) -> str:
     thread = "M4" if key is None or key.width <= 5 else "M5" if key.width <= 8 else "M6"
     length = {"M4": 6, "M5": 8, "M6": 10}[thread]
     return f"set screw ISO 4029 {thread} x {length} - 45H"
+
+
+def set_screw_size(designation: str) -> tuple[str, float]:
+    """``(thread, length mm)`` of a :func:`set_screw` designation (``... M5 x 8 - 45H``)."""
+    found = re.search(r"ISO 4029 (M\d+) x (\d+(?:\.\d+)?)", designation)
+    if found is None:
+        raise ValueError(f"not an ISO 4029 set screw: {designation!r}")
+    return found.group(1), float(found.group(2))
 
 
 @dataclass(frozen=True)

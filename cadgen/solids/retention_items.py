@@ -20,16 +20,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
 
 import numpy as np
 
 from cadgen.solids.bought import BoughtItem, item_frame
 
-__all__ = ["ring_items", "set_screw_gears", "radial_set_screw", "SET_SCREW"]
+__all__ = ["ring_items", "set_screw_gears", "radial_set_screw"]
 
-#: A hub set screw's designation: ``set screw ISO 4029 M5 x 8 - 45H`` (the bill's words).
-SET_SCREW = re.compile(r"ISO 4029 (M\d+) x (\d+(?:\.\d+)?)")
 #: mm the drilled hole runs past the outline, so the cut leaves no skin.
 _DRILL_BEYOND = 1.0
 
@@ -53,13 +50,6 @@ def ring_items(shaft, retention, z_floor: float) -> list:
     return items
 
 
-def _thread(designation: str) -> tuple[str, float]:
-    found = SET_SCREW.search(designation)
-    if found is None:
-        raise ValueError(f"not an ISO 4029 set screw: {designation!r}")
-    return found.group(1), float(found.group(2))
-
-
 def radial_set_screw(designation: str, shaft_diameter: float, key, angle: float, centre,
                      z: float, reach: float, segments: int):
     """A set screw through a hub onto its key: ``(hole, item)``, the tap-drilled hole (a
@@ -70,7 +60,9 @@ def radial_set_screw(designation: str, shaft_diameter: float, key, angle: float,
     from cadgen.solids.extrude import manifold3d_engine
 
     m3d = manifold3d_engine()
-    thread, length = _thread(designation)
+    from cadgen.machine.retention import set_screw_size
+
+    thread, length = set_screw_size(designation)
     direction = np.array([math.cos(angle), math.sin(angle)])
     centre = np.asarray(centre, dtype=float)
     back = shaft_diameter / 2 - key.shaft_depth + key.height
